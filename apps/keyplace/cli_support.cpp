@@ -1,0 +1,78 @@
+#include "cli_support.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+#include "keyplace/io/atomic_file.hpp"
+
+namespace keyplace::cli {
+
+void WriteJson(const std::string& path, const nlohmann::json& json) {
+  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+}
+
+ScanRange ParseScanRange(const std::string& text, std::size_t count) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) {
+    throw std::invalid_argument("--scans '" + text + "': expected A:B (e.g. 0:50, :100, 200:)");
+  }
+  const auto parse = [&](const std::string& part, std::size_t fallback) -> std::size_t {
+    if (part.empty()) return fallback;
+    std::size_t used = 0;
+    long long value = -1;
+    try {
+      value = std::stoll(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != part.size() || value < 0) {
+      throw std::invalid_argument("--scans '" + text + "': '" + part +
+                                  "' is not a non-negative integer");
+    }
+    return static_cast<std::size_t>(value);
+  };
+  ScanRange range;
+  range.begin = std::min(parse(text.substr(0, colon), 0), count);
+  range.end = std::min(parse(text.substr(colon + 1), count), count);
+  if (range.end < range.begin) {
+    throw std::invalid_argument("--scans '" + text + "': end is before begin");
+  }
+  return range;
+}
+
+Progress::Progress(std::string label, std::size_t total)
+    : label_(std::move(label)),
+      total_(total),
+      start_(std::chrono::steady_clock::now()),
+      last_print_(start_) {
+  const char* env = std::getenv("KEYPLACE_PROGRESS");
+  enabled_ = env != nullptr ? std::string(env) == "1" : isatty(fileno(stderr)) != 0;
+}
+
+void Progress::Update(std::size_t done) {
+  if (!enabled_ || total_ == 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_print_ < std::chrono::milliseconds(250) && done < total_) return;
+  last_print_ = now;
+  const double elapsed_s = std::chrono::duration<double>(now - start_).count();
+  const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+  const double eta_s = fraction > 0.0 ? elapsed_s * (1.0 - fraction) / fraction : 0.0;
+  fmt::print(stderr, "\r{}  {}/{}  {:3.0f} %  ETA {:.0f} s   ", label_, done, total_,
+             100.0 * fraction, eta_s);
+  std::fflush(stderr);
+}
+
+void Progress::Finish() {
+  if (!enabled_ || total_ == 0) return;
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  fmt::print(stderr, "\r{}  {}/{}  done in {:.1f} s          \n", label_, total_, total_,
+             elapsed_s);
+}
+
+}  // namespace keyplace::cli

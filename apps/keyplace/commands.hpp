@@ -1,0 +1,13 @@
+#pragma once
+// Each subcommand of the keyplace tool lives in its own <name>_command.cpp and registers itself
+// on the CLI11 app with one of these functions (called from main.cpp).
+
+#include <CLI/CLI.hpp>
+
+namespace keyplace::cli {
+
+void RegisterInfoCommand(CLI::App& app);
+void RegisterFeaturesCommand(CLI::App& app);
+void RegisterOdometryCommand(CLI::App& app);
+
+}  // namespace keyplace::cli

@@ -1,0 +1,65 @@
+#pragma once
+// Reader for CARMEN text logs (plain or gzip-compressed).
+
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/io/laser_scan.hpp"
+
+namespace keyplace {
+
+struct OdometryMessage {
+  Pose2 pose;                // robot pose in the odometry frame
+  double tv_mps = 0.0;       // translational velocity
+  double rv_radps = 0.0;     // rotational velocity
+  double timestamp_s = 0.0;  // ipc_timestamp
+  double logger_timestamp_s = 0.0;
+};
+
+/// VERTEX2 id x y theta: a node of the corrected pose graph.
+struct GraphVertex {
+  long id = 0;
+  Pose2 pose;
+};
+
+/// EDGE2 from to dx dy dtheta + information matrix (TORO order I_xx I_xy I_yy I_tt I_xt I_yt).
+struct GraphEdge {
+  long from = 0;
+  long to = 0;
+  Pose2 T_from_to;
+  double information[6] = {0, 0, 0, 0, 0, 0};
+  bool loop = false;  // listed after a "#LOOP EDGES" comment
+};
+
+struct CarmenLog {
+  std::string path;
+  std::vector<LaserScan> scans;  // FLASER / RLASER / ROBOTLASER1 in file order
+  std::vector<OdometryMessage> odometry;
+  std::vector<GraphVertex> vertices;
+  std::vector<GraphEdge> edges;
+  std::map<std::string, std::string> params;       // PARAM name -> value
+  std::map<std::string, std::size_t> line_counts;  // per message type, plus "#comment", "unknown"
+  std::size_t lines = 0;
+  std::size_t invalid_beams = 0;    // beams marked invalid because of NaN/inf/negative values
+  std::size_t no_return_beams = 0;  // beams at or beyond max range (normal "no echo")
+  // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
+  // stored in LaserScan::corrected_pose instead of odometry_pose.
+  bool corrected = false;
+};
+
+struct CarmenReadOptions {
+  // "no return" threshold for FLASER/RLASER lines, which carry no max range of their own (m).
+  // ROBOTLASER1 lines use their own max_range field. Ranges >= this are invalid.
+  double flaser_max_range_m = 80.0;
+  // Overrides the decision taken from the file content (VERTEX2 / NEFF lines) when set.
+  enum class PoseKind { kAuto, kCorrected, kOdometry } pose_kind = PoseKind::kAuto;
+};
+
+/// Reads a CARMEN log. Throws std::invalid_argument naming file, line and field on malformed
+/// input, std::runtime_error when the file cannot be opened or is truncated.
+CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
+
+}  // namespace keyplace

@@ -1,0 +1,355 @@
+#include "keyplace/io/carmen_log.hpp"
+
+#include <zlib.h>
+
+#include <charconv>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace keyplace {
+namespace {
+
+// Reads a plain or gzip-compressed text file line by line (zlib reads plain files as they are).
+class LineReader {
+ public:
+  explicit LineReader(const std::string& path) : path_(path), file_(gzopen(path.c_str(), "rb")) {
+    if (file_ == nullptr) throw std::runtime_error(path + ": cannot open file");
+    gzbuffer(file_, 1 << 17);
+  }
+  ~LineReader() {
+    if (file_ != nullptr) gzclose(file_);
+  }
+  LineReader(const LineReader&) = delete;
+  LineReader& operator=(const LineReader&) = delete;
+
+  // Next line without its end-of-line characters; false at the end of the file.
+  bool Next(std::string& line) {
+    line.clear();
+    char chunk[1 << 14];
+    while (gzgets(file_, chunk, sizeof(chunk)) != nullptr) {
+      line.append(chunk);
+      if (!line.empty() && line.back() == '\n') break;
+    }
+    int error_code = Z_OK;
+    const char* message = gzerror(file_, &error_code);
+    if (error_code != Z_OK && error_code != Z_STREAM_END) {
+      throw std::runtime_error(path_ + ": truncated or corrupt compressed data after line " +
+                               std::to_string(line_number_) + " (" + message + ")");
+    }
+    if (line.empty() && gzeof(file_)) return false;
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    ++line_number_;
+    return true;
+  }
+
+  std::size_t line_number() const { return line_number_; }
+
+ private:
+  std::string path_;
+  gzFile file_;
+  std::size_t line_number_ = 0;
+};
+
+void Tokenize(std::string_view line, std::vector<std::string_view>& tokens) {
+  tokens.clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+}
+
+// Parses the fields of one line; every error names file, line, message type and field.
+class FieldParser {
+ public:
+  FieldParser(const std::string& path, std::size_t line,
+              const std::vector<std::string_view>& tokens)
+      : path_(path), line_(line), tokens_(tokens) {}
+
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw std::invalid_argument(path_ + ":" + std::to_string(line_) + ": " +
+                                std::string(tokens_.front()) + ": " + what);
+  }
+
+  void ExpectFieldCount(std::size_t expected, const std::string& layout) const {
+    if (tokens_.size() != expected) {
+      Fail("expected " + std::to_string(expected) + " fields (" + layout + "), found " +
+           std::to_string(tokens_.size()));
+    }
+  }
+
+  void ExpectAtLeast(std::size_t expected, const std::string& layout) const {
+    if (tokens_.size() < expected) {
+      Fail("expected at least " + std::to_string(expected) + " fields (" + layout + "), found " +
+           std::to_string(tokens_.size()));
+    }
+  }
+
+  // A number that must be finite.
+  double Number(std::size_t index, const std::string& field) const {
+    const double value = AnyNumber(index, field);
+    if (!std::isfinite(value)) Fail("field '" + field + "' is not finite: '" + Token(index) + "'");
+    return value;
+  }
+
+  // A number that may be NaN or infinite (ranges: such beams are marked invalid).
+  double AnyNumber(std::size_t index, const std::string& field) const {
+    if (index >= tokens_.size()) Fail("missing field '" + field + "'");
+    const std::string_view token = tokens_[index];
+    double value = 0.0;
+    const char* begin = token.data();
+    const char* end = token.data() + token.size();
+    if (begin != end && *begin == '+') ++begin;
+    const auto result = std::from_chars(begin, end, value);
+    if (result.ec != std::errc() || result.ptr != end) {
+      Fail("field '" + field + "' is not a number: '" + std::string(token) + "'");
+    }
+    return value;
+  }
+
+  long Integer(std::size_t index, const std::string& field) const {
+    if (index >= tokens_.size()) Fail("missing field '" + field + "'");
+    const std::string_view token = tokens_[index];
+    long value = 0;
+    const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (result.ec != std::errc() || result.ptr != token.data() + token.size()) {
+      Fail("field '" + field + "' is not an integer: '" + std::string(token) + "'");
+    }
+    return value;
+  }
+
+  std::size_t Count(std::size_t index, const std::string& field, long max_count) const {
+    const long value = Integer(index, field);
+    if (value < 0 || value > max_count) {
+      Fail("field '" + field + "' = " + std::to_string(value) + " is out of range [0, " +
+           std::to_string(max_count) + "]");
+    }
+    return static_cast<std::size_t>(value);
+  }
+
+  std::string Token(std::size_t index) const { return std::string(tokens_.at(index)); }
+  std::size_t size() const { return tokens_.size(); }
+
+ private:
+  const std::string& path_;
+  std::size_t line_;
+  const std::vector<std::string_view>& tokens_;
+};
+
+constexpr long kMaxBeams = 100000;
+
+struct ReaderState {
+  CarmenLog log;
+  CarmenReadOptions options;
+  bool in_loop_edges = false;
+  bool saw_corrected_marker = false;
+};
+
+// Marks each beam valid or not and counts the bad ones.
+void ClassifyBeams(LaserScan& scan, CarmenLog& log) {
+  scan.valid.assign(scan.ranges_m.size(), 0);
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double range = scan.ranges_m[i];
+    if (!std::isfinite(range) || range <= 0.0) {
+      ++log.invalid_beams;
+    } else if (range >= scan.max_range_m) {
+      ++log.no_return_beams;
+    } else {
+      scan.valid[i] = 1;
+    }
+  }
+}
+
+double ParamDegrees(const CarmenLog& log, const std::string& name, double fallback_deg) {
+  const auto it = log.params.find(name);
+  if (it == log.params.end()) return fallback_deg;
+  double value = 0.0;
+  const auto result =
+      std::from_chars(it->second.data(), it->second.data() + it->second.size(), value);
+  return result.ec == std::errc() && value > 0.0 ? value : fallback_deg;
+}
+
+// FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
+LaserScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& state, bool front) {
+  fields.ExpectAtLeast(2, "name n ...");
+  const std::size_t n = fields.Count(1, "n (beam count)", kMaxBeams);
+  const std::string layout = "name n, " + std::to_string(n) +
+                             " ranges, laser x y theta, robot x y theta, ipc_timestamp, host, "
+                             "logger_timestamp";
+  fields.ExpectFieldCount(n + 11, layout);
+  LaserScan scan;
+  scan.line = line;
+  scan.max_range_m = state.options.flaser_max_range_m;
+  // FLASER carries no angular geometry: take the field of view from PARAM when the log gives it,
+  // else 180 degrees, and spread the beams as FLIRTLib does (start -fov/2, step fov/n).
+  const std::string prefix = front ? "laser_front_laser_" : "laser_rear_laser_";
+  const double resolution_deg = ParamDegrees(state.log, prefix + "resolution", 0.0);
+  double fov_deg = ParamDegrees(state.log, prefix + "fov", 0.0);
+  if (fov_deg <= 0.0)
+    fov_deg = resolution_deg > 0.0 ? resolution_deg * static_cast<double>(n) : 180.0;
+  const double fov_rad = fov_deg * M_PI / 180.0;
+  const double step_rad = n > 0 ? fov_rad / static_cast<double>(n) : 0.0;
+  scan.ranges_m.resize(n);
+  scan.angles_rad.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    scan.ranges_m[i] = fields.AnyNumber(2 + i, "range[" + std::to_string(i) + "]");
+    scan.angles_rad[i] = -0.5 * fov_rad + static_cast<double>(i) * step_rad;
+  }
+  const std::size_t p = 2 + n;
+  const Pose2 laser(fields.Number(p, "laser x"), fields.Number(p + 1, "laser y"),
+                    fields.Number(p + 2, "laser theta"));
+  const Pose2 robot(fields.Number(p + 3, "robot x"), fields.Number(p + 4, "robot y"),
+                    fields.Number(p + 5, "robot theta"));
+  scan.odometry_pose = robot;  // moved to corrected_pose at the end for corrected logs
+  scan.T_robot_laser = Between(robot, laser);
+  scan.timestamp_s = fields.Number(p + 6, "ipc_timestamp");
+  scan.logger_timestamp_s = fields.Number(p + 8, "logger_timestamp");
+  ClassifyBeams(scan, state.log);
+  return scan;
+}
+
+// ROBOTLASER1 type start fov res max_range accuracy remission_mode n r1..rn m rem1..remm
+//   laser x y theta robot x y theta tv rv forward_safety side_safety turn_axis ipc host logger
+LaserScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState& state) {
+  fields.ExpectAtLeast(9,
+                       "name type start_angle fov resolution max_range accuracy "
+                       "remission_mode n ...");
+  const double start_rad = fields.Number(2, "start_angle");
+  const double resolution_rad = fields.Number(4, "angular_resolution");
+  const double max_range_m = fields.Number(5, "max_range");
+  const std::size_t n = fields.Count(8, "n (beam count)", kMaxBeams);
+  fields.ExpectAtLeast(10 + n, "9 header fields, " + std::to_string(n) + " ranges, m ...");
+  const std::size_t m = fields.Count(9 + n, "m (remission count)", kMaxBeams);
+  fields.ExpectFieldCount(n + m + 24, "9 header fields, " + std::to_string(n) + " ranges, m, " +
+                                          std::to_string(m) +
+                                          " remissions, laser pose, robot pose, tv rv "
+                                          "forward_safety side_safety turn_axis, ipc_timestamp, "
+                                          "host, logger_timestamp");
+  if (max_range_m <= 0.0) fields.Fail("field 'max_range' must be positive");
+  LaserScan scan;
+  scan.line = line;
+  scan.max_range_m = max_range_m;
+  scan.ranges_m.resize(n);
+  scan.angles_rad.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    scan.ranges_m[i] = fields.AnyNumber(9 + i, "range[" + std::to_string(i) + "]");
+    scan.angles_rad[i] = start_rad + static_cast<double>(i) * resolution_rad;
+  }
+  const std::size_t p = 10 + n + m;
+  const Pose2 laser(fields.Number(p, "laser x"), fields.Number(p + 1, "laser y"),
+                    fields.Number(p + 2, "laser theta"));
+  const Pose2 robot(fields.Number(p + 3, "robot x"), fields.Number(p + 4, "robot y"),
+                    fields.Number(p + 5, "robot theta"));
+  scan.odometry_pose = robot;
+  scan.T_robot_laser = Between(robot, laser);
+  scan.timestamp_s = fields.Number(p + 11, "ipc_timestamp");
+  scan.logger_timestamp_s = fields.Number(p + 13, "logger_timestamp");
+  ClassifyBeams(scan, state.log);
+  return scan;
+}
+
+void ParseLine(const std::string& path, std::size_t line_number,
+               const std::vector<std::string_view>& tokens, ReaderState& state) {
+  CarmenLog& log = state.log;
+  const std::string_view type = tokens.front();
+  if (type.front() == '#') {
+    ++log.line_counts["#comment"];
+    std::string text;
+    for (const auto& token : tokens) text.append(token).push_back(' ');
+    if (text.find("LOOP EDGES") != std::string::npos) state.in_loop_edges = true;
+    if (text.find("SEQUENTIAL EDGES") != std::string::npos) state.in_loop_edges = false;
+    return;
+  }
+  const FieldParser fields(path, line_number, tokens);
+  if (type == "FLASER") {
+    log.scans.push_back(ParseFlaser(fields, line_number, state, true));
+  } else if (type == "RLASER") {
+    ParseFlaser(fields, line_number, state, false);  // validated and counted, not a front scan
+  } else if (type == "ROBOTLASER1") {
+    log.scans.push_back(ParseRobotLaser(fields, line_number, state));
+  } else if (type == "ODOM") {
+    fields.ExpectFieldCount(10, "ODOM x y theta tv rv accel ipc_timestamp host logger_timestamp");
+    OdometryMessage odom;
+    odom.pose = Pose2(fields.Number(1, "x"), fields.Number(2, "y"), fields.Number(3, "theta"));
+    odom.tv_mps = fields.Number(4, "tv");
+    odom.rv_radps = fields.Number(5, "rv");
+    odom.timestamp_s = fields.Number(7, "ipc_timestamp");
+    odom.logger_timestamp_s = fields.Number(9, "logger_timestamp");
+    log.odometry.push_back(odom);
+  } else if (type == "PARAM") {
+    fields.ExpectAtLeast(3, "PARAM name value ...");
+    log.params[fields.Token(1)] = fields.Token(2);
+  } else if (type == "VERTEX2") {
+    fields.ExpectFieldCount(5, "VERTEX2 id x y theta");
+    GraphVertex vertex;
+    vertex.id = fields.Integer(1, "id");
+    vertex.pose = Pose2(fields.Number(2, "x"), fields.Number(3, "y"), fields.Number(4, "theta"));
+    log.vertices.push_back(vertex);
+    state.saw_corrected_marker = true;
+  } else if (type == "EDGE2") {
+    fields.ExpectFieldCount(12, "EDGE2 from to dx dy dtheta I_xx I_xy I_yy I_tt I_xt I_yt");
+    GraphEdge edge;
+    edge.from = fields.Integer(1, "from");
+    edge.to = fields.Integer(2, "to");
+    edge.T_from_to =
+        Pose2(fields.Number(3, "dx"), fields.Number(4, "dy"), fields.Number(5, "dtheta"));
+    static const char* const kInfoNames[6] = {"I_xx", "I_xy", "I_yy", "I_tt", "I_xt", "I_yt"};
+    for (int k = 0; k < 6; ++k) edge.information[k] = fields.Number(6 + k, kInfoNames[k]);
+    edge.loop = state.in_loop_edges;
+    log.edges.push_back(edge);
+  } else if (type == "NEFF") {
+    state.saw_corrected_marker = true;  // GMapping output: the scans carry corrected poses
+  } else {
+    ++log.line_counts["unknown"];
+    return;
+  }
+  ++log.line_counts[std::string(type)];
+}
+
+}  // namespace
+
+CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
+  if (!(options.flaser_max_range_m > 0.0)) {
+    throw std::invalid_argument("CarmenReadOptions.flaser_max_range_m must be positive");
+  }
+  ReaderState state;
+  state.options = options;
+  state.log.path = path;
+  LineReader reader(path);
+  std::string line;
+  std::vector<std::string_view> tokens;
+  while (reader.Next(line)) {
+    Tokenize(line, tokens);
+    if (tokens.empty()) continue;
+    ParseLine(path, reader.line_number(), tokens, state);
+  }
+  CarmenLog& log = state.log;
+  log.lines = reader.line_number();
+  switch (options.pose_kind) {
+    case CarmenReadOptions::PoseKind::kCorrected:
+      log.corrected = true;
+      break;
+    case CarmenReadOptions::PoseKind::kOdometry:
+      log.corrected = false;
+      break;
+    case CarmenReadOptions::PoseKind::kAuto:
+      log.corrected = state.saw_corrected_marker;
+      break;
+  }
+  if (log.corrected) {
+    for (auto& scan : log.scans) {
+      scan.corrected_pose = scan.odometry_pose;
+      scan.odometry_pose.reset();
+    }
+  }
+  return std::move(state.log);
+}
+
+}  // namespace keyplace
