@@ -1,0 +1,47 @@
+# keyplace — top-level entry points. `make demo` and `make test` work on a fresh Debian 12 machine.
+BUILD_DIR ?= build
+BUILD_TYPE ?= Release
+JOBS ?= $(shell nproc)
+KEYPLACE := $(BUILD_DIR)/keyplace
+DEMO_LOG := data/fr079-corrected.log.gz
+DEMO_OUT := $(BUILD_DIR)/demo
+
+.PHONY: all deps configure build demo test bench format format-check tidy install clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# The main job on the bundled data set, printing its results.
+demo: build
+	@bash scripts/demo.sh $(KEYPLACE) $(DEMO_LOG) $(DEMO_OUT)
+
+test: build format-check
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	@bash scripts/run-benchmarks.sh $(BUILD_DIR)
+
+format:
+	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
+
+format-check:
+	@git ls-files '*.cpp' '*.hpp' | xargs clang-format --dry-run --Werror
+	@echo "format-check: clang-format clean"
+
+tidy: configure
+	@git ls-files 'src/*.cpp' 'apps/*.cpp' | xargs -P $(JOBS) -n 4 clang-tidy -p $(BUILD_DIR) --quiet 2>/dev/null
+	@echo "tidy: clang-tidy clean"
+
+install: build
+	@cmake --install $(BUILD_DIR) --prefix $(or $(PREFIX),/usr/local)
+
+clean:
+	@rm -rf $(BUILD_DIR)

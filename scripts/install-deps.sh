@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages keyplace needs to build, test and run its demo.
+# Only missing packages are installed; prints nothing when everything is already there.
+# Usage: scripts/install-deps.sh [--check]   (--check: list what is missing, exit 1 if any)
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake pkg-config git
+  # libraries (DESIGN.md: dependencies)
+  libeigen3-dev libnanoflann-dev libceres-dev zlib1g-dev libsqlite3-dev sqlite3
+  libcli11-dev libfmt-dev libspdlog-dev libtbb-dev libcairo2-dev libyaml-cpp-dev
+  nlohmann-json3-dev pybind11-dev python3-dev
+  # tests, benchmarks, style
+  libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ "${1:-}" = "--check" ]; then
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "missing: ${missing[*]}"
+    exit 1
+  fi
+  exit 0
+fi
+
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    sudo_cmd=(sudo)
+  else
+    echo "install-deps: not root and no sudo; install these packages yourself: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

@@ -1,0 +1,183 @@
+#include "keyplace/io/carmen_log.hpp"
+
+#include <zlib.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "support/test_data.hpp"
+
+namespace keyplace {
+namespace {
+
+std::string WriteText(const std::string& name, const std::string& text) {
+  const std::string path = testing::MakeTempDir("carmen") + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string Flaser(int beams, const std::string& range, const std::string& tail) {
+  std::string line = "FLASER " + std::to_string(beams);
+  for (int i = 0; i < beams; ++i) line += " " + range;
+  return line + " " + tail + "\n";
+}
+
+// Expects `read` to throw E whose message contains every fragment.
+template <typename E>
+void ExpectError(const std::string& path, std::initializer_list<std::string> fragments) {
+  try {
+    ReadCarmenLog(path);
+    FAIL() << "no exception for " << path;
+  } catch (const E& error) {
+    const std::string message = error.what();
+    for (const auto& fragment : fragments) {
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "message '" << message << "' lacks '" << fragment << "'";
+    }
+  }
+}
+
+TEST(CarmenLog, ReadsRawLogLineTypes) {
+  const std::string path =
+      WriteText("raw.log",
+                "# a header comment\n"
+                "PARAM robot_frontlaser_offset -0.04 nohost 0\n"
+                "ODOM 1.0 2.0 0.5 0.1 0.2 0 100.5 host 0.5\n" +
+                    Flaser(4, "2.5", "0.96 2.0 0.5 1.0 2.0 0.5 100.6 host 0.6") +
+                    "SYNC something 1 2\n"
+                    "\n" +
+                    Flaser(4, "81.9", "1 2 0 1 2 0 100.7 host 0.7"));
+  const CarmenLog log = ReadCarmenLog(path);
+  ASSERT_EQ(log.scans.size(), 2u);
+  EXPECT_FALSE(log.corrected);
+  EXPECT_EQ(log.line_counts.at("FLASER"), 2u);
+  EXPECT_EQ(log.line_counts.at("ODOM"), 1u);
+  EXPECT_EQ(log.line_counts.at("PARAM"), 1u);
+  EXPECT_EQ(log.line_counts.at("#comment"), 1u);
+  EXPECT_EQ(log.line_counts.at("unknown"), 1u);
+  EXPECT_EQ(log.params.at("robot_frontlaser_offset"), "-0.04");
+  ASSERT_EQ(log.odometry.size(), 1u);
+  EXPECT_DOUBLE_EQ(log.odometry[0].pose.theta, 0.5);
+  EXPECT_DOUBLE_EQ(log.odometry[0].timestamp_s, 100.5);
+
+  const LaserScan& scan = log.scans[0];
+  EXPECT_EQ(scan.line, 4u);
+  ASSERT_EQ(scan.size(), 4u);
+  // FLASER: 180 degrees, start -pi/2, step pi/n (FLIRTLib's convention).
+  EXPECT_DOUBLE_EQ(scan.angles_rad[0], -M_PI / 2.0);
+  EXPECT_NEAR(scan.angles_rad[1] - scan.angles_rad[0], M_PI / 4.0, 1e-12);
+  EXPECT_EQ(scan.CountValid(), 4u);
+  ASSERT_TRUE(scan.odometry_pose.has_value());
+  EXPECT_FALSE(scan.corrected_pose.has_value());
+  EXPECT_DOUBLE_EQ(scan.odometry_pose->x, 1.0);
+  // Laser 4 cm behind the robot along its heading (0.5 rad).
+  EXPECT_NEAR(scan.T_robot_laser.x, -0.04, 1e-2);
+  EXPECT_NEAR(scan.T_robot_laser.theta, 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(scan.timestamp_s, 100.6);
+  EXPECT_DOUBLE_EQ(scan.logger_timestamp_s, 0.6);
+  // 81.9 m readings are "no return": beyond the 80 m FLASER threshold.
+  EXPECT_EQ(log.scans[1].CountValid(), 0u);
+  EXPECT_EQ(log.no_return_beams, 4u);
+  EXPECT_EQ(log.invalid_beams, 0u);
+}
+
+TEST(CarmenLog, FieldOfViewFromParam) {
+  const std::string path = WriteText("fov.log", "PARAM laser_front_laser_fov 100 nohost 0\n" +
+                                                    Flaser(10, "1.0", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog log = ReadCarmenLog(path);
+  ASSERT_EQ(log.scans.size(), 1u);
+  EXPECT_NEAR(log.scans[0].angles_rad[0], -50.0 * M_PI / 180.0, 1e-12);
+  EXPECT_NEAR(log.scans[0].angles_rad[1] - log.scans[0].angles_rad[0], 10.0 * M_PI / 180.0, 1e-12);
+}
+
+TEST(CarmenLog, BadBeamsAreMarkedInvalidAndCounted) {
+  const std::string path =
+      WriteText("bad_beams.log", "FLASER 5 1.0 nan inf -2.0 0 0 0 0 0 0 0 1 h 1\n");
+  const CarmenLog log = ReadCarmenLog(path);
+  ASSERT_EQ(log.scans.size(), 1u);
+  EXPECT_EQ(log.scans[0].CountValid(), 1u);
+  EXPECT_EQ(log.scans[0].valid[0], 1);
+  EXPECT_EQ(log.invalid_beams, 4u);  // NaN, inf, negative and zero
+}
+
+TEST(CarmenLog, CorrectedLogKeepsCorrectedPoseAndGraph) {
+  const std::string path =
+      WriteText("corrected.log",
+                "VERTEX2 0 1.5 -2.0 0.25\n"
+                "ROBOTLASER1 0 -1.570796 3.141593 0.785398 50.0 0.1 0 5 1 2 60 3 4 0 "
+                "1.46 -2.01 0.25 1.5 -2.0 0.25 0 0 0 0 0 10.5 x 0.0\n"
+                "#LOOP EDGES\n"
+                "EDGE2 0 1 0.1 0.2 0.3 100 0 100 500 0 0\n");
+  const CarmenLog log = ReadCarmenLog(path);
+  ASSERT_EQ(log.scans.size(), 1u);
+  EXPECT_TRUE(log.corrected);
+  const LaserScan& scan = log.scans[0];
+  ASSERT_TRUE(scan.corrected_pose.has_value());
+  EXPECT_FALSE(scan.odometry_pose.has_value());
+  EXPECT_DOUBLE_EQ(scan.corrected_pose->x, 1.5);
+  EXPECT_DOUBLE_EQ(scan.max_range_m, 50.0);
+  EXPECT_DOUBLE_EQ(scan.angles_rad[2], -1.570796 + 2 * 0.785398);  // from the line's own fields
+  EXPECT_EQ(scan.CountValid(), 4u);  // 60 m >= the line's 50 m max range
+  ASSERT_EQ(log.edges.size(), 1u);
+  EXPECT_TRUE(log.edges[0].loop);
+  EXPECT_DOUBLE_EQ(log.edges[0].information[3], 500.0);
+  ASSERT_EQ(log.vertices.size(), 1u);
+}
+
+TEST(CarmenLog, ReadsBundledGzipLog) {
+  const CarmenLog log = ReadCarmenLog(testing::SourceDir() + "/data/fr079-corrected.log.gz");
+  ASSERT_EQ(log.scans.size(), 1464u);
+  EXPECT_TRUE(log.corrected);
+  EXPECT_EQ(log.vertices.size(), 1464u);
+  EXPECT_EQ(log.edges.size(), 2307u);
+  for (std::size_t i = 0; i < log.scans.size(); i += 97) {
+    const auto& scan = log.scans[i];
+    ASSERT_EQ(scan.size(), 360u);
+    ASSERT_TRUE(scan.corrected_pose.has_value());
+    // VERTEX2 i is the corrected robot pose of the i-th laser line.
+    EXPECT_NEAR(scan.corrected_pose->x, log.vertices[i].pose.x, 1e-9);
+    EXPECT_NEAR(scan.corrected_pose->theta, log.vertices[i].pose.theta, 1e-9);
+    // FR079's laser sits 4 cm behind the robot centre.
+    EXPECT_NEAR(scan.T_robot_laser.x, -0.04, 1e-3);
+    EXPECT_NEAR(scan.T_robot_laser.y, 0.0, 1e-3);
+  }
+}
+
+TEST(CarmenLog, WrongBeamCountNamesFileLineAndLayout) {
+  const std::string path = WriteText("short.log", "# c\nFLASER 5 1 2 3 4 0 0 0 0 0 0 1 h 1\n");
+  ExpectError<std::invalid_argument>(path, {path + ":2", "FLASER", "expected 16 fields"});
+}
+
+TEST(CarmenLog, NonNumericFieldIsNamed) {
+  const std::string path = WriteText("nan_pose.log", "FLASER 2 1 2 0 zero 0 0 0 0 1 h 1\n");
+  ExpectError<std::invalid_argument>(path, {path + ":1", "laser y", "'zero'"});
+  const std::string odom = WriteText("odom.log", "ODOM 1 2 3 4 5 6 7 h\n");
+  ExpectError<std::invalid_argument>(odom, {odom + ":1", "ODOM", "expected 10 fields"});
+  const std::string count = WriteText("count.log", "FLASER -3 1 2\n");
+  ExpectError<std::invalid_argument>(count, {count + ":1", "beam count"});
+}
+
+TEST(CarmenLog, TruncatedGzipIsAnError) {
+  const std::string dir = testing::MakeTempDir("carmen-gz");
+  const std::string path = dir + "/truncated.log.gz";
+  std::string text;
+  for (int i = 0; i < 2000; ++i) text += Flaser(20, "1.25", "0 0 0 0 0 0 1 h 1");
+  gzFile out = gzopen(path.c_str(), "wb");
+  gzwrite(out, text.data(), static_cast<unsigned>(text.size()));
+  gzclose(out);
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size() / 2);
+  ExpectError<std::runtime_error>(path, {path, "truncated"});
+}
+
+TEST(CarmenLog, MissingFileIsAnError) {
+  ExpectError<std::runtime_error>("/nonexistent/keyplace.log", {"/nonexistent/keyplace.log"});
+}
+
+}  // namespace
+}  // namespace keyplace
