@@ -1,0 +1,112 @@
+#pragma once
+// Scan odometry: registers each scan against a local map of recent key scans with point-to-line
+// ICP, initialised by the odometry increment, and falls back to odometry (flagged) when ICP
+// fails. Scans are processed in the order they are added (for Intel raw: logger_timestamp).
+
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/registration/icp.hpp"
+
+namespace keyplace {
+
+struct ScanOdometryConfig {
+  IcpConfig icp;
+
+  // Beams shorter than this or at/after this range are not used (m). The far limit also drops
+  // the sparse, noisy long returns that do not help local registration.
+  double min_range_m = 0.1;
+  double max_range_m = 30.0;
+
+  // The local map holds the last `local_map_scans` key scans (their endpoints in the world
+  // frame). A scan becomes a key scan when its registered laser pose has moved at least
+  // keyframe_translation_m or turned keyframe_rotation_rad since the last key scan; a stationary
+  // robot therefore does not wash the map out with copies of one view.
+  int local_map_scans = 10;
+  double keyframe_translation_m = 0.1;
+  double keyframe_rotation_rad = 0.0872664626;  // 5 deg
+
+  // An ICP result that moves the pose further than this from the odometry-predicted pose is
+  // rejected (fallback to odometry, flagged). Guards against converging into a wrong minimum.
+  double max_correction_translation_m = 0.5;
+  double max_correction_rotation_rad = 0.3490658504;  // 20 deg
+};
+
+/// Throws std::invalid_argument naming the first invalid field (including icp.*).
+void ValidateScanOdometryConfig(const ScanOdometryConfig& config);
+
+enum class ScanOdometryStatus {
+  kFirstScan,                   // defines the world frame (= odometry frame at the first scan)
+  kRegistered,                  // ICP converged and was accepted
+  kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
+  kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
+  kFallbackTooFewPoints,        // scan or map too small for ICP: odometry used
+};
+
+std::string ToString(ScanOdometryStatus status);
+
+struct ScanOdometryResult {
+  std::size_t sequence = 0;  // 0-based order in which the scan was added
+  double timestamp_s = 0.0;  // the scan's ipc timestamp, copied
+  // Estimated robot pose in the world frame. World = the odometry frame of the first scan, so
+  // T_world_robot of the first scan equals its odometry pose (identity without odometry).
+  Pose2 T_world_robot;
+  Pose2 T_world_laser;                      // T_world_robot * T_robot_laser
+  Pose2 T_world_robot_odometry_prediction;  // the ICP initial guess, as a robot pose
+  ScanOdometryStatus status = ScanOdometryStatus::kFirstScan;
+  bool converged = false;   // true for kRegistered and kFirstScan
+  bool fell_back = false;   // true for every kFallback* status
+  bool degenerate = false;  // ICP held a weak direction at the odometry guess
+  bool keyframe = false;    // the scan was added to the local map
+  IcpStatus icp_status = IcpStatus::kTooFewPoints;
+  int iterations = 0;
+  double inlier_ratio = 0.0;
+  double residual_rms_m = 0.0;
+  double seconds = 0.0;  // wall time spent on this scan (filtering, ICP, map update)
+};
+
+class ScanOdometry {
+ public:
+  explicit ScanOdometry(const ScanOdometryConfig& config = {});
+  ~ScanOdometry();
+  ScanOdometry(const ScanOdometry&) = delete;
+  ScanOdometry& operator=(const ScanOdometry&) = delete;
+
+  /// Registers the next scan. The odometry increment since the previous scan initialises ICP;
+  /// a scan without odometry_pose is predicted with zero motion.
+  ScanOdometryResult Add(const LaserScan& scan);
+
+  const ScanOdometryConfig& config() const { return config_; }
+  std::size_t num_scans() const { return num_scans_; }
+  std::size_t num_map_points() const { return map_points_.size(); }
+
+  /// Endpoints of the scan's usable beams (range filter of the config), in the laser frame.
+  static std::vector<Eigen::Vector2d> FilteredEndpoints(const LaserScan& scan,
+                                                        const ScanOdometryConfig& config);
+
+ private:
+  void AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser, const Pose2& T_world_laser);
+
+  ScanOdometryConfig config_;
+  std::size_t num_scans_ = 0;
+  bool have_previous_odometry_ = false;
+  Pose2 previous_odometry_laser_;  // T_odom_laser of the previous scan
+  Pose2 previous_T_world_laser_;
+  Pose2 last_keyframe_T_world_laser_;
+  struct Keyframe {
+    std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
+    PointNormals normals_world;                 // fitted within the scan, rotated to world
+  };
+  std::deque<Keyframe> keyframes_;
+  std::vector<Eigen::Vector2d> map_points_;  // concatenation of the keyframes' points
+  std::unique_ptr<IcpTarget> target_;        // over map_points_
+};
+
+}  // namespace keyplace

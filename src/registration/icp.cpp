@@ -1,0 +1,371 @@
+#include "keyplace/registration/icp.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
+
+namespace keyplace {
+namespace {
+
+// nanoflann reads the caller's points through this adaptor (no copy).
+struct PointsAdaptor {
+  const std::vector<Eigen::Vector2d>* points;
+
+  std::size_t kdtree_get_point_count() const { return points->size(); }
+  double kdtree_get_pt(std::size_t index, std::size_t dim) const { return (*points)[index][dim]; }
+  template <class BoundingBox>
+  bool kdtree_get_bbox(BoundingBox& /*bbox*/) const {
+    return false;
+  }
+};
+
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
+    nanoflann::L2_Simple_Adaptor<double, PointsAdaptor, double, std::size_t>, PointsAdaptor, 2,
+    std::size_t>;
+
+constexpr int kMaxNormalNeighbours = 64;
+// How many past iterates are checked for a cycle of the association.
+constexpr int kCycleMemory = 10;
+
+void Require(bool condition, const char* field, const char* what) {
+  if (!condition) {
+    throw std::invalid_argument(std::string("IcpConfig.") + field + " " + what);
+  }
+}
+
+double KernelWeight(RobustKernel kernel, double scale_m, double residual_m) {
+  const double a = std::abs(residual_m);
+  switch (kernel) {
+    case RobustKernel::kNone:
+      return 1.0;
+    case RobustKernel::kHuber:
+      return a <= scale_m ? 1.0 : scale_m / a;
+    case RobustKernel::kCauchy: {
+      const double u = residual_m / scale_m;
+      return 1.0 / (1.0 + u * u);
+    }
+    case RobustKernel::kTukey: {
+      if (a >= scale_m) return 0.0;
+      const double u = residual_m / scale_m;
+      const double v = 1.0 - u * u;
+      return v * v;
+    }
+  }
+  return 1.0;
+}
+
+}  // namespace
+
+std::string ToString(IcpStatus status) {
+  switch (status) {
+    case IcpStatus::kConverged:
+      return "converged";
+    case IcpStatus::kMaxIterations:
+      return "max_iterations";
+    case IcpStatus::kTooFewPoints:
+      return "too_few_points";
+    case IcpStatus::kTooFewInliers:
+      return "too_few_inliers";
+    case IcpStatus::kSingular:
+      return "singular";
+  }
+  return "unknown";
+}
+
+std::string ToString(RobustKernel kernel) {
+  switch (kernel) {
+    case RobustKernel::kNone:
+      return "none";
+    case RobustKernel::kHuber:
+      return "huber";
+    case RobustKernel::kCauchy:
+      return "cauchy";
+    case RobustKernel::kTukey:
+      return "tukey";
+  }
+  return "unknown";
+}
+
+void ValidateIcpConfig(const IcpConfig& c) {
+  Require(c.max_correspondence_distance_m > 0.0, "max_correspondence_distance_m", "must be > 0");
+  Require(c.inlier_distance_m > 0.0, "inlier_distance_m", "must be > 0");
+  Require(c.kernel_scale_m > 0.0, "kernel_scale_m", "must be > 0");
+  Require(c.normal_neighbours >= 2 && c.normal_neighbours <= kMaxNormalNeighbours,
+          "normal_neighbours", "must be in [2, 64]");
+  Require(c.normal_max_neighbour_distance_m > 0.0, "normal_max_neighbour_distance_m",
+          "must be > 0");
+  Require(c.normal_max_eigenvalue_ratio >= 0.0 && c.normal_max_eigenvalue_ratio <= 1.0,
+          "normal_max_eigenvalue_ratio", "must be in [0, 1]");
+  Require(c.max_iterations >= 1, "max_iterations", "must be >= 1");
+  Require(c.convergence_translation_m >= 0.0, "convergence_translation_m", "must be >= 0");
+  Require(c.convergence_rotation_rad >= 0.0, "convergence_rotation_rad", "must be >= 0");
+  Require(c.degeneracy_min_eigenvalue >= 0.0, "degeneracy_min_eigenvalue", "must be >= 0");
+  Require(c.min_points >= 3, "min_points", "must be >= 3");
+  Require(c.min_inliers >= 0, "min_inliers", "must be >= 0");
+  Require(c.min_inlier_ratio >= 0.0 && c.min_inlier_ratio <= 1.0, "min_inlier_ratio",
+          "must be in [0, 1]");
+}
+
+// ------------------------------------------------------------------------------------------
+// IcpTarget
+
+struct IcpTarget::Impl {
+  const std::vector<Eigen::Vector2d>& points;
+  PointsAdaptor adaptor;
+  KdTree tree;
+  PointNormals normals;
+
+  explicit Impl(const std::vector<Eigen::Vector2d>& pts)
+      : points(pts),
+        adaptor{&pts},
+        tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
+};
+
+namespace {
+
+PointNormals NormalsFromTree(const std::vector<Eigen::Vector2d>& points, const KdTree& tree,
+                             const IcpConfig& config) {
+  const std::size_t n = points.size();
+  PointNormals out;
+  out.normals.assign(n, Eigen::Vector2d::Zero());
+  out.valid.assign(n, 0);
+  if (n < 3) return out;
+  const std::size_t k =
+      std::min<std::size_t>(static_cast<std::size_t>(config.normal_neighbours), n);
+  const double max_d2 =
+      config.normal_max_neighbour_distance_m * config.normal_max_neighbour_distance_m;
+  std::array<std::size_t, kMaxNormalNeighbours> indices{};
+  std::array<double, kMaxNormalNeighbours> d2{};
+  for (std::size_t i = 0; i < n; ++i) {
+    nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(k);
+    result.init(indices.data(), d2.data());
+    tree.findNeighbors(result, points[i].data(), nanoflann::SearchParams());
+    const std::size_t found = result.size();
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    int count = 0;
+    for (std::size_t j = 0; j < found; ++j) {
+      if (d2[j] > max_d2) continue;
+      mean += points[indices[j]];
+      ++count;
+    }
+    if (count < 3) continue;
+    mean /= count;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (std::size_t j = 0; j < found; ++j) {
+      if (d2[j] > max_d2) continue;
+      const Eigen::Vector2d d = points[indices[j]] - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
+    eig.computeDirect(cov);
+    const double lmin = eig.eigenvalues()(0);
+    const double lmax = eig.eigenvalues()(1);
+    if (!(lmax > 0.0) || lmin > config.normal_max_eigenvalue_ratio * lmax) continue;
+    out.normals[i] = eig.eigenvectors().col(0).normalized();
+    out.valid[i] = 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+PointNormals EstimateNormals(const std::vector<Eigen::Vector2d>& points, const IcpConfig& config) {
+  ValidateIcpConfig(config);
+  const PointsAdaptor adaptor{&points};
+  const KdTree tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  return NormalsFromTree(points, tree, config);
+}
+
+IcpTarget::IcpTarget(const std::vector<Eigen::Vector2d>& points, const IcpConfig& config) {
+  ValidateIcpConfig(config);
+  impl_ = std::make_unique<Impl>(points);
+  impl_->normals = NormalsFromTree(points, impl_->tree, config);
+}
+
+IcpTarget::IcpTarget(const std::vector<Eigen::Vector2d>& points, PointNormals normals,
+                     const IcpConfig& config) {
+  ValidateIcpConfig(config);
+  if (normals.normals.size() != points.size() || normals.valid.size() != points.size()) {
+    throw std::invalid_argument(
+        "IcpTarget: normals.normals and normals.valid must have one entry per point");
+  }
+  impl_ = std::make_unique<Impl>(points);
+  impl_->normals = std::move(normals);
+}
+
+IcpTarget::~IcpTarget() = default;
+
+std::size_t IcpTarget::size() const { return impl_->points.size(); }
+const std::vector<Eigen::Vector2d>& IcpTarget::points() const { return impl_->points; }
+const Eigen::Vector2d& IcpTarget::normal(std::size_t i) const { return impl_->normals.normals[i]; }
+bool IcpTarget::HasNormal(std::size_t i) const { return impl_->normals.valid[i] != 0; }
+std::size_t IcpTarget::CountNormals() const {
+  return static_cast<std::size_t>(
+      std::count(impl_->normals.valid.begin(), impl_->normals.valid.end(), std::uint8_t{1}));
+}
+
+bool IcpTarget::Nearest(const Eigen::Vector2d& query, std::size_t* index,
+                        double* squared_distance_m2) const {
+  if (impl_->points.empty()) return false;
+  std::size_t found_index = 0;
+  double found_d2 = 0.0;
+  nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(1);
+  result.init(&found_index, &found_d2);
+  impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (result.size() == 0) return false;
+  if (index != nullptr) *index = found_index;
+  if (squared_distance_m2 != nullptr) *squared_distance_m2 = found_d2;
+  return true;
+}
+
+// ------------------------------------------------------------------------------------------
+// Alignment
+
+IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
+                           const Pose2& T_target_source_guess, const IcpConfig& config) {
+  ValidateIcpConfig(config);
+  IcpResult result;
+  result.T_target_source = T_target_source_guess;
+  result.num_source_points = static_cast<int>(source.size());
+  const int min_points = config.min_points;
+  if (static_cast<int>(source.size()) < min_points ||
+      static_cast<int>(target.size()) < min_points || static_cast<int>(target.CountNormals()) < 3) {
+    result.status = IcpStatus::kTooFewPoints;
+    return result;
+  }
+
+  const double gate_d2 =
+      config.max_correspondence_distance_m * config.max_correspondence_distance_m;
+  double x = T_target_source_guess.x;
+  double y = T_target_source_guess.y;
+  double theta = T_target_source_guess.theta;
+  bool numerically_converged = false;
+  std::vector<Eigen::Vector3d> history;  // poses after each update (x, y, theta)
+  history.reserve(static_cast<std::size_t>(config.max_iterations));
+  bool singular = false;
+
+  for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
+    result.iterations = iteration;
+    const double c = std::cos(theta);
+    const double s = std::sin(theta);
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (const Eigen::Vector2d& p : source) {
+      // Source point relative to the sensor origin, rotated into the target frame.
+      const Eigen::Vector2d rp(c * p.x() - s * p.y(), s * p.x() + c * p.y());
+      const Eigen::Vector2d pt(rp.x() + x, rp.y() + y);
+      std::size_t index = 0;
+      double d2 = 0.0;
+      if (!target.Nearest(pt, &index, &d2) || d2 > gate_d2 || !target.HasNormal(index)) continue;
+      const Eigen::Vector2d& n = target.normal(index);
+      const double r = n.dot(pt - target.points()[index]);
+      // d r / d(dx, dy, dtheta), rotation about the current sensor origin.
+      const Eigen::Vector3d J(n.x(), n.y(), n.y() * rp.x() - n.x() * rp.y());
+      const double w = KernelWeight(config.kernel, config.kernel_scale_m, r);
+      H.noalias() += w * J * J.transpose();
+      g.noalias() += w * r * J;
+      ++count;
+    }
+    if (count < 3) {
+      singular = true;
+      break;
+    }
+    // Solve in the eigen-basis of H; directions whose mean information is below the threshold
+    // are held (solution remapping), which keeps a corridor at the initial guess along its axis.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(H);
+    const Eigen::Vector3d lambda = eig.eigenvalues();
+    const double threshold =
+        std::max(config.degeneracy_min_eigenvalue * count, 1e-12 * std::max(1.0, lambda(2)));
+    Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+    int held = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (lambda(i) < threshold) {
+        ++held;
+        continue;
+      }
+      const Eigen::Vector3d v = eig.eigenvectors().col(i);
+      delta -= v * (v.dot(g) / lambda(i));
+    }
+    result.degenerate = held > 0;
+    result.min_information_eigenvalue = lambda(0) / count;
+    if (held == 3) {
+      singular = true;
+      break;
+    }
+    x += delta(0);
+    y += delta(1);
+    theta = WrapAngle(theta + delta(2));
+    if (std::hypot(delta(0), delta(1)) < config.convergence_translation_m &&
+        std::abs(delta(2)) < config.convergence_rotation_rad) {
+      numerically_converged = true;
+      break;
+    }
+    // Nearest-neighbour association can switch back and forth between a few correspondence
+    // sets: the iterates then cycle through the same poses. A return to a recent pose is
+    // convergence as well; the estimate is the mean of the poses of the cycle.
+    const Eigen::Vector3d current(x, y, theta);
+    for (int back = 2; back <= kCycleMemory && back <= static_cast<int>(history.size()); ++back) {
+      const Eigen::Vector3d& earlier = history[history.size() - back];
+      if (std::hypot(current(0) - earlier(0), current(1) - earlier(1)) <
+              config.convergence_translation_m &&
+          std::abs(WrapAngle(current(2) - earlier(2))) < config.convergence_rotation_rad) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int j = 1; j < back; ++j) {
+          const Eigen::Vector3d& member = history[history.size() - j];
+          sum += Eigen::Vector3d(member(0), member(1), theta + WrapAngle(member(2) - theta));
+        }
+        sum += current;
+        x = sum(0) / back;
+        y = sum(1) / back;
+        theta = WrapAngle(sum(2) / back);
+        result.cycled = true;
+        numerically_converged = true;
+        break;
+      }
+    }
+    if (numerically_converged) break;
+    history.push_back(current);
+  }
+
+  const Pose2 estimate(x, y, theta);
+  // Final statistics at the estimate.
+  int inliers = 0;
+  double sum_r2 = 0.0;
+  for (const Eigen::Vector2d& p : source) {
+    const Eigen::Vector2d pt = estimate * p;
+    std::size_t index = 0;
+    double d2 = 0.0;
+    if (!target.Nearest(pt, &index, &d2) || d2 > gate_d2 || !target.HasNormal(index)) continue;
+    const double r = target.normal(index).dot(pt - target.points()[index]);
+    if (std::abs(r) > config.inlier_distance_m) continue;
+    ++inliers;
+    sum_r2 += r * r;
+  }
+  result.num_inliers = inliers;
+  result.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(source.size());
+  result.residual_rms_m = inliers > 0 ? std::sqrt(sum_r2 / inliers) : 0.0;
+
+  if (singular) {
+    result.status = IcpStatus::kSingular;
+    return result;  // T_target_source stays at the guess
+  }
+  result.T_target_source = estimate;
+  if (!numerically_converged) {
+    result.status = IcpStatus::kMaxIterations;
+  } else if (inliers < config.min_inliers || result.inlier_ratio < config.min_inlier_ratio) {
+    result.status = IcpStatus::kTooFewInliers;
+  } else {
+    result.status = IcpStatus::kConverged;
+    result.converged = true;
+  }
+  if (!result.converged) result.T_target_source = T_target_source_guess;
+  return result;
+}
+
+}  // namespace keyplace

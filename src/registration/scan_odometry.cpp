@@ -1,0 +1,177 @@
+#include "keyplace/registration/scan_odometry.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace keyplace {
+namespace {
+
+void Require(bool condition, const char* field, const char* what) {
+  if (!condition) {
+    throw std::invalid_argument(std::string("ScanOdometryConfig.") + field + " " + what);
+  }
+}
+
+}  // namespace
+
+std::string ToString(ScanOdometryStatus status) {
+  switch (status) {
+    case ScanOdometryStatus::kFirstScan:
+      return "first_scan";
+    case ScanOdometryStatus::kRegistered:
+      return "registered";
+    case ScanOdometryStatus::kFallbackNotConverged:
+      return "fallback_not_converged";
+    case ScanOdometryStatus::kFallbackCorrectionTooLarge:
+      return "fallback_correction_too_large";
+    case ScanOdometryStatus::kFallbackTooFewPoints:
+      return "fallback_too_few_points";
+  }
+  return "unknown";
+}
+
+void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
+  try {
+    ValidateIcpConfig(c.icp);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(std::string("ScanOdometryConfig.icp: ") + error.what());
+  }
+  Require(c.min_range_m >= 0.0, "min_range_m", "must be >= 0");
+  Require(c.max_range_m > c.min_range_m, "max_range_m", "must be > min_range_m");
+  Require(c.local_map_scans >= 1, "local_map_scans", "must be >= 1");
+  Require(c.keyframe_translation_m >= 0.0, "keyframe_translation_m", "must be >= 0");
+  Require(c.keyframe_rotation_rad >= 0.0, "keyframe_rotation_rad", "must be >= 0");
+  Require(c.max_correction_translation_m > 0.0, "max_correction_translation_m", "must be > 0");
+  Require(c.max_correction_rotation_rad > 0.0, "max_correction_rotation_rad", "must be > 0");
+}
+
+ScanOdometry::ScanOdometry(const ScanOdometryConfig& config) : config_(config) {
+  ValidateScanOdometryConfig(config_);
+}
+
+ScanOdometry::~ScanOdometry() = default;
+
+std::vector<Eigen::Vector2d> ScanOdometry::FilteredEndpoints(const LaserScan& scan,
+                                                             const ScanOdometryConfig& config) {
+  std::vector<Eigen::Vector2d> points;
+  const std::size_t n = std::min(scan.ranges_m.size(), scan.angles_rad.size());
+  points.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i < scan.valid.size() && scan.valid[i] == 0) continue;
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r < config.min_range_m || r >= config.max_range_m) continue;
+    const double a = scan.angles_rad[i];
+    points.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return points;
+}
+
+void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
+                               const Pose2& T_world_laser) {
+  target_.reset();  // it refers to map_points_, which changes now
+  Keyframe keyframe;
+  // Normals are fitted within the one scan (no cross-scan noise), then rotated with it.
+  keyframe.normals_world = EstimateNormals(points_laser, config_.icp);
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(T_world_laser.theta).toRotationMatrix();
+  for (Eigen::Vector2d& n : keyframe.normals_world.normals) n = R * n;
+  keyframe.points_world.reserve(points_laser.size());
+  for (const Eigen::Vector2d& p : points_laser) keyframe.points_world.push_back(T_world_laser * p);
+  keyframes_.push_back(std::move(keyframe));
+  while (static_cast<int>(keyframes_.size()) > config_.local_map_scans) keyframes_.pop_front();
+
+  map_points_.clear();
+  PointNormals map_normals;
+  for (const Keyframe& k : keyframes_) {
+    map_points_.insert(map_points_.end(), k.points_world.begin(), k.points_world.end());
+    map_normals.normals.insert(map_normals.normals.end(), k.normals_world.normals.begin(),
+                               k.normals_world.normals.end());
+    map_normals.valid.insert(map_normals.valid.end(), k.normals_world.valid.begin(),
+                             k.normals_world.valid.end());
+  }
+  target_ = std::make_unique<IcpTarget>(map_points_, std::move(map_normals), config_.icp);
+  last_keyframe_T_world_laser_ = T_world_laser;
+}
+
+ScanOdometryResult ScanOdometry::Add(const LaserScan& scan) {
+  const auto start = std::chrono::steady_clock::now();
+  ScanOdometryResult result;
+  result.sequence = num_scans_;
+  result.timestamp_s = scan.timestamp_s;
+  const Pose2& T_robot_laser = scan.T_robot_laser;
+  const std::vector<Eigen::Vector2d> points = FilteredEndpoints(scan, config_);
+
+  // Odometry increment of the laser since the previous scan.
+  Pose2 odometry_increment;  // identity without odometry
+  if (scan.odometry_pose) {
+    const Pose2 odometry_laser = *scan.odometry_pose * T_robot_laser;
+    if (have_previous_odometry_)
+      odometry_increment = Between(previous_odometry_laser_, odometry_laser);
+    previous_odometry_laser_ = odometry_laser;
+    have_previous_odometry_ = true;
+  }
+
+  if (num_scans_ == 0) {
+    const Pose2 T_world_robot = scan.odometry_pose ? *scan.odometry_pose : Pose2();
+    result.T_world_robot = T_world_robot;
+    result.T_world_laser = T_world_robot * T_robot_laser;
+    result.T_world_robot_odometry_prediction = T_world_robot;
+    result.status = ScanOdometryStatus::kFirstScan;
+    result.converged = true;
+    result.icp_status = IcpStatus::kConverged;
+    result.keyframe = true;
+    AddKeyframe(points, result.T_world_laser);
+  } else {
+    const Pose2 predicted_T_world_laser = previous_T_world_laser_ * odometry_increment;
+    result.T_world_robot_odometry_prediction = predicted_T_world_laser * T_robot_laser.inverse();
+    Pose2 T_world_laser = predicted_T_world_laser;
+    if (target_ == nullptr || static_cast<int>(points.size()) < config_.icp.min_points ||
+        static_cast<int>(map_points_.size()) < config_.icp.min_points) {
+      result.status = ScanOdometryStatus::kFallbackTooFewPoints;
+      result.icp_status = IcpStatus::kTooFewPoints;
+    } else {
+      const IcpResult icp =
+          AlignPointToLine(*target_, points, predicted_T_world_laser, config_.icp);
+      result.icp_status = icp.status;
+      result.iterations = icp.iterations;
+      result.inlier_ratio = icp.inlier_ratio;
+      result.residual_rms_m = icp.residual_rms_m;
+      result.degenerate = icp.degenerate;
+      if (!icp.converged) {
+        result.status = icp.status == IcpStatus::kTooFewPoints
+                            ? ScanOdometryStatus::kFallbackTooFewPoints
+                            : ScanOdometryStatus::kFallbackNotConverged;
+      } else {
+        const Pose2 correction = Between(predicted_T_world_laser, icp.T_target_source);
+        if (TranslationNorm(correction) > config_.max_correction_translation_m ||
+            std::abs(correction.theta) > config_.max_correction_rotation_rad) {
+          result.status = ScanOdometryStatus::kFallbackCorrectionTooLarge;
+        } else {
+          result.status = ScanOdometryStatus::kRegistered;
+          T_world_laser = icp.T_target_source;
+        }
+      }
+    }
+    result.converged = result.status == ScanOdometryStatus::kRegistered;
+    result.fell_back = !result.converged;
+    result.T_world_laser = T_world_laser;
+    result.T_world_robot = T_world_laser * T_robot_laser.inverse();
+
+    const Pose2 since_keyframe = Between(last_keyframe_T_world_laser_, T_world_laser);
+    if (!points.empty() && (TranslationNorm(since_keyframe) >= config_.keyframe_translation_m ||
+                            std::abs(since_keyframe.theta) >= config_.keyframe_rotation_rad ||
+                            static_cast<int>(map_points_.size()) < config_.icp.min_points)) {
+      result.keyframe = true;
+      AddKeyframe(points, T_world_laser);
+    }
+  }
+  previous_T_world_laser_ = result.T_world_laser;
+  ++num_scans_;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace keyplace

@@ -1,0 +1,236 @@
+#include "keyplace/registration/icp.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "synthetic_scene.hpp"
+
+namespace keyplace {
+namespace {
+
+using testing::CastScan;
+using testing::DegToRad;
+using testing::Endpoints;
+using testing::RadToDeg;
+using testing::ScanOptions;
+
+// Pose error of `estimate` against `truth`: translation (m) and |rotation| (deg).
+struct PoseError {
+  double translation_m;
+  double rotation_deg;
+};
+PoseError ErrorOf(const Pose2& estimate, const Pose2& truth) {
+  const Pose2 e = Between(truth, estimate);
+  return {TranslationNorm(e), std::abs(RadToDeg(e.theta))};
+}
+
+struct Pair {
+  std::vector<Eigen::Vector2d> target;
+  std::vector<Eigen::Vector2d> source;
+  Pose2 T_target_source;
+};
+
+Pair MakePair(const std::vector<testing::Segment>& world, const Pose2& T_world_target,
+              const Pose2& T_world_source, const ScanOptions& options, std::mt19937* rng) {
+  Pair pair;
+  pair.target = Endpoints(CastScan(world, T_world_target, options, rng));
+  pair.source = Endpoints(CastScan(world, T_world_source, options, rng));
+  pair.T_target_source = Between(T_world_target, T_world_source);
+  return pair;
+}
+
+TEST(IcpTest, RecoversKnownTransformInPolygonalRoom) {
+  const auto world = testing::IrregularRoom();
+  for (const int beams : {180, 360}) {
+    ScanOptions options;
+    options.beams = beams;
+    const Pair pair =
+        MakePair(world, Pose2(0.2, -0.3, 0.1), Pose2(0.45, -0.1, 0.16), options, nullptr);
+    const IcpConfig config;
+    const IcpTarget target(pair.target, config);
+    // Guess off by 15 cm and 4 degrees.
+    const Pose2 guess = pair.T_target_source * Pose2(0.12, -0.09, DegToRad(4.0));
+    const IcpResult result = AlignPointToLine(target, pair.source, guess, config);
+    ASSERT_TRUE(result.converged) << ToString(result.status) << " beams " << beams;
+    EXPECT_EQ(result.status, IcpStatus::kConverged);
+    const PoseError error = ErrorOf(result.T_target_source, pair.T_target_source);
+    EXPECT_LT(error.translation_m, 1e-3) << "beams " << beams;
+    EXPECT_LT(error.rotation_deg, 0.05) << "beams " << beams;
+    EXPECT_GT(result.inlier_ratio, 0.9);
+    EXPECT_LT(result.residual_rms_m, 5e-3);  // pairs near corners are not exact
+    EXPECT_GT(result.iterations, 1);
+    EXPECT_LT(result.iterations, config.max_iterations);
+    EXPECT_FALSE(result.degenerate);
+  }
+}
+
+TEST(IcpTest, RecoversTransformUnderNoiseAndOutliers) {
+  const auto world = testing::IrregularRoom();
+  std::mt19937 rng(42);
+  ScanOptions options;
+  options.range_noise_m = 0.01;
+  options.outlier_fraction = 0.15;
+  const IcpConfig config;
+  double worst_m = 0.0;
+  double worst_deg = 0.0;
+  for (int trial = 0; trial < 10; ++trial) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Pose2 T_world_target(u(rng), u(rng) * 0.8, u(rng));
+    // Keep the sensor (and the moved sensor) well away from the pillar at (0.4..1.1, 0.5..1.1).
+    while (T_world_target.x > -0.1 && T_world_target.y > -0.2) {
+      T_world_target = Pose2(u(rng), u(rng) * 0.8, u(rng));
+    }
+    const Pose2 motion(0.3 * u(rng), 0.3 * u(rng), DegToRad(10.0) * u(rng));
+    const Pair pair = MakePair(world, T_world_target, T_world_target * motion, options, &rng);
+    const IcpTarget target(pair.target, config);
+    const Pose2 guess =
+        pair.T_target_source * Pose2(0.1 * u(rng), 0.1 * u(rng), DegToRad(3.0) * u(rng));
+    const IcpResult result = AlignPointToLine(target, pair.source, guess, config);
+    ASSERT_TRUE(result.converged) << "trial " << trial << " " << ToString(result.status);
+    const PoseError error = ErrorOf(result.T_target_source, pair.T_target_source);
+    worst_m = std::max(worst_m, error.translation_m);
+    worst_deg = std::max(worst_deg, error.rotation_deg);
+    EXPECT_GT(result.inlier_ratio, 0.5);
+    EXPECT_LT(result.inlier_ratio, 0.95);  // the outliers are not inliers
+  }
+  EXPECT_LT(worst_m, 0.01);
+  EXPECT_LT(worst_deg, 0.3);
+}
+
+TEST(IcpTest, RobustKernelBeatsPlainLeastSquaresWithOutliers) {
+  const auto world = testing::IrregularRoom();
+  std::mt19937 rng(7);
+  ScanOptions options;
+  options.range_noise_m = 0.005;
+  options.outlier_fraction = 0.3;
+  const Pair pair = MakePair(world, Pose2(0, 0, 0), Pose2(0.2, 0.1, 0.05), options, &rng);
+  IcpConfig robust;
+  IcpConfig plain = robust;
+  plain.kernel = RobustKernel::kNone;
+  const Pose2 guess = pair.T_target_source * Pose2(0.05, -0.05, 0.03);
+  const IcpTarget target_robust(pair.target, robust);
+  const IcpResult r = AlignPointToLine(target_robust, pair.source, guess, robust);
+  const IcpResult p = AlignPointToLine(target_robust, pair.source, guess, plain);
+  const double robust_error = ErrorOf(r.T_target_source, pair.T_target_source).translation_m;
+  const double plain_error = ErrorOf(p.T_target_source, pair.T_target_source).translation_m;
+  EXPECT_LT(robust_error, 0.01);
+  EXPECT_LT(robust_error, plain_error);
+}
+
+TEST(IcpTest, DegenerateCorridorStaysAtGuessAlongTheAxis) {
+  const auto world = testing::Corridor(1.0);
+  std::mt19937 rng(3);
+  ScanOptions options;
+  options.max_range_m = 10.0;  // the corridor ends are out of range
+  options.range_noise_m = 0.01;
+  const Pose2 T_world_target(0.0, 0.1, 0.02);
+  const Pose2 T_world_source(0.5, -0.05, 0.06);  // true motion: 0.5 m along the corridor
+  const Pair pair = MakePair(world, T_world_target, T_world_source, options, &rng);
+  const IcpConfig config;
+  const IcpTarget target(pair.target, config);
+  // Odometry believes in 0.35 m along the axis, and is off laterally / in heading.
+  const Pose2 T_world_guess(0.35, 0.03, 0.0);
+  const Pose2 guess = Between(T_world_target, T_world_guess);
+  const IcpResult result = AlignPointToLine(target, pair.source, guess, config);
+  EXPECT_TRUE(result.degenerate);
+  ASSERT_TRUE(result.converged) << ToString(result.status);
+  const Pose2 T_world_estimate = T_world_target * result.T_target_source;
+  // Along the axis: stays at the guess (no sliding); across and in heading: corrected.
+  EXPECT_NEAR(T_world_estimate.x, T_world_guess.x, 0.03);
+  EXPECT_NEAR(T_world_estimate.y, T_world_source.y, 0.01);
+  EXPECT_NEAR(T_world_estimate.theta, T_world_source.theta, DegToRad(0.3));
+}
+
+TEST(IcpTest, EmptyAndTinyInputsGiveAClearResult) {
+  const auto world = testing::IrregularRoom();
+  const std::vector<Eigen::Vector2d> room = Endpoints(CastScan(world, Pose2(), ScanOptions{}));
+  const std::vector<Eigen::Vector2d> empty;
+  const std::vector<Eigen::Vector2d> tiny = {{1.0, 0.0}, {1.0, 0.1}};
+  const IcpConfig config;
+  const Pose2 guess(0.1, 0.2, 0.3);
+  {
+    const IcpTarget target(room, config);
+    for (const auto* source : {&empty, &tiny}) {
+      const IcpResult result = AlignPointToLine(target, *source, guess, config);
+      EXPECT_FALSE(result.converged);
+      EXPECT_EQ(result.status, IcpStatus::kTooFewPoints);
+      EXPECT_EQ(result.iterations, 0);
+      EXPECT_DOUBLE_EQ(result.T_target_source.x, guess.x);
+      EXPECT_DOUBLE_EQ(result.T_target_source.theta, guess.theta);
+    }
+  }
+  for (const auto* points : {&empty, &tiny}) {
+    const IcpTarget target(*points, config);
+    EXPECT_EQ(target.CountNormals(), 0u);
+    const IcpResult result = AlignPointToLine(target, room, guess, config);
+    EXPECT_FALSE(result.converged);
+    EXPECT_EQ(result.status, IcpStatus::kTooFewPoints);
+  }
+  // Source far away from the target: no correspondences at all.
+  const IcpTarget target(room, config);
+  const IcpResult far = AlignPointToLine(target, room, Pose2(100.0, 0.0, 0.0), config);
+  EXPECT_FALSE(far.converged);
+  EXPECT_EQ(far.status, IcpStatus::kSingular);
+  EXPECT_DOUBLE_EQ(far.T_target_source.x, 100.0);
+}
+
+TEST(IcpTest, KdTreeNearestMatchesBruteForce) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::vector<Eigen::Vector2d> points(2000);
+  for (auto& p : points) p = {u(rng), u(rng)};
+  const IcpTarget target(points, IcpConfig{});
+  EXPECT_EQ(&target.points(), &points);  // an adaptor over the caller's points, no copy
+  for (int q = 0; q < 500; ++q) {
+    const Eigen::Vector2d query(u(rng) * 1.2, u(rng) * 1.2);
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
+    std::size_t index = 0;
+    double d2 = 0.0;
+    ASSERT_TRUE(target.Nearest(query, &index, &d2));
+    EXPECT_DOUBLE_EQ(d2, best);
+    EXPECT_DOUBLE_EQ((points[index] - query).squaredNorm(), best);
+  }
+}
+
+TEST(IcpTest, NormalsArePerpendicularToWallsAndMissingAtCorners) {
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i <= 20; ++i) points.emplace_back(0.05 * i, 0.0);     // wall along x
+  for (int i = 1; i <= 20; ++i) points.emplace_back(0.0, 0.05 * i);     // wall along y
+  for (int i = 0; i < 5; ++i) points.emplace_back(5.0 + 3.0 * i, 7.0);  // isolated points
+  IcpConfig config;
+  config.normal_neighbours = 5;
+  const IcpTarget target(points, config);
+  ASSERT_TRUE(target.HasNormal(10));
+  EXPECT_NEAR(std::abs(target.normal(10).y()), 1.0, 1e-12);
+  ASSERT_TRUE(target.HasNormal(30));
+  EXPECT_NEAR(std::abs(target.normal(30).x()), 1.0, 1e-12);
+  EXPECT_FALSE(target.HasNormal(0));  // the corner
+  for (std::size_t i = 41; i < points.size(); ++i) EXPECT_FALSE(target.HasNormal(i));
+}
+
+TEST(IcpTest, InvalidConfigThrowsNamingTheField) {
+  const std::vector<Eigen::Vector2d> points = {{0, 0}, {1, 0}, {2, 0}};
+  IcpConfig config;
+  config.max_correspondence_distance_m = -1.0;
+  try {
+    const IcpTarget target(points, config);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("max_correspondence_distance_m"), std::string::npos);
+  }
+  IcpConfig good;
+  const IcpTarget target(points, good);
+  IcpConfig bad_iterations;
+  bad_iterations.max_iterations = 0;
+  EXPECT_THROW(AlignPointToLine(target, points, Pose2(), bad_iterations), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace keyplace

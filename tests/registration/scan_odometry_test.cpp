@@ -1,0 +1,162 @@
+#include "keyplace/registration/scan_odometry.hpp"
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "synthetic_scene.hpp"
+
+namespace keyplace {
+namespace {
+
+using testing::CastScan;
+using testing::DegToRad;
+using testing::ScanOptions;
+
+// A robot drives a loop through the irregular room; its odometry has a scale error and a heading
+// bias, so that the dead-reckoned path drifts. Scans are cast from the true laser poses.
+struct Drive {
+  std::vector<Pose2> truth_robot;
+  std::vector<LaserScan> scans;
+};
+
+Drive MakeDrive(const std::vector<testing::Segment>& world, int steps, const Pose2& step_motion,
+                const Pose2& start, const Pose2& T_robot_laser, const ScanOptions& options,
+                std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  Drive drive;
+  Pose2 truth = start;
+  Pose2 odometry = start;
+  for (int i = 0; i < steps; ++i) {
+    if (i > 0) {
+      truth = truth * step_motion;
+      // Odometry: 5 % too long, and 0.5 deg per step heading bias.
+      odometry = odometry * Pose2(step_motion.x * 1.05, step_motion.y * 1.05,
+                                  step_motion.theta + DegToRad(0.5));
+    }
+    LaserScan scan = CastScan(world, truth * T_robot_laser, options, &rng);
+    scan.T_robot_laser = T_robot_laser;
+    scan.odometry_pose = odometry;
+    scan.timestamp_s = 100.0 + 0.1 * i;
+    drive.truth_robot.push_back(truth);
+    drive.scans.push_back(std::move(scan));
+  }
+  return drive;
+}
+
+TEST(ScanOdometryTest, CorrectsDriftingOdometryInARoom) {
+  const auto world = testing::IrregularRoom();
+  ScanOptions options;
+  options.beams = 180;
+  options.fov_rad = M_PI;
+  options.range_noise_m = 0.01;
+  const Pose2 T_robot_laser(-0.04, 0.0, 0.0);
+  // A circle of radius ~1.3 m around (0.5, 0.2): 60 steps of 0.1 m / 4.5 deg.
+  const Drive drive = MakeDrive(world, 60, Pose2(0.1, 0.0, DegToRad(4.5)), Pose2(0.5, -1.1, 0.0),
+                                T_robot_laser, options, 5);
+  ScanOdometry odometry;
+  int registered = 0;
+  double worst_m = 0.0;
+  double worst_deg = 0.0;
+  for (std::size_t i = 0; i < drive.scans.size(); ++i) {
+    const ScanOdometryResult result = odometry.Add(drive.scans[i]);
+    EXPECT_EQ(result.sequence, i);
+    EXPECT_DOUBLE_EQ(result.timestamp_s, drive.scans[i].timestamp_s);
+    if (i == 0) {
+      EXPECT_EQ(result.status, ScanOdometryStatus::kFirstScan);
+      EXPECT_DOUBLE_EQ(result.T_world_robot.x, drive.truth_robot[0].x);
+    }
+    registered += result.status == ScanOdometryStatus::kRegistered ? 1 : 0;
+    EXPECT_GE(result.seconds, 0.0);
+    const Pose2 error = Between(drive.truth_robot[i], result.T_world_robot);
+    worst_m = std::max(worst_m, TranslationNorm(error));
+    worst_deg = std::max(worst_deg, std::abs(testing::RadToDeg(error.theta)));
+  }
+  const Pose2 odometry_end_error =
+      Between(drive.truth_robot.back(), *drive.scans.back().odometry_pose);
+  ASSERT_GT(TranslationNorm(odometry_end_error), 0.5);  // the odometry really drifts
+  EXPECT_EQ(registered, 59);
+  EXPECT_LT(worst_m, 0.03);
+  EXPECT_LT(worst_deg, 0.5);
+}
+
+TEST(ScanOdometryTest, CorridorDoesNotSlideAwayFromOdometry) {
+  const auto world = testing::Corridor(1.0);
+  ScanOptions options;
+  options.beams = 360;
+  options.fov_rad = M_PI;
+  options.max_range_m = 10.0;
+  options.range_noise_m = 0.01;
+  // 40 steps of 0.1 m along the corridor; the odometry says 0.105 m per step and turns a bit.
+  const Drive drive =
+      MakeDrive(world, 40, Pose2(0.1, 0.0, 0.0), Pose2(0.0, 0.0, 0.0), Pose2(), options, 9);
+  ScanOdometry odometry;
+  ScanOdometryResult last;
+  for (const LaserScan& scan : drive.scans) last = odometry.Add(scan);
+  const Pose2& odom_end = *drive.scans.back().odometry_pose;
+  const Pose2& truth_end = drive.truth_robot.back();
+  // Along the axis the only information is odometry's: the estimate follows it (4.1 m, not the
+  // true 3.9 m and certainly not somewhere else).
+  EXPECT_NEAR(last.T_world_robot.x, 39 * 0.105, 0.1);
+  // Heading and lateral position are measured by the walls and corrected.
+  EXPECT_NEAR(last.T_world_robot.y, truth_end.y, 0.02);
+  EXPECT_NEAR(last.T_world_robot.theta, truth_end.theta, DegToRad(0.5));
+  EXPECT_GT(std::abs(odom_end.theta), DegToRad(15.0));  // odometry's heading is far off
+  EXPECT_TRUE(last.degenerate);
+}
+
+TEST(ScanOdometryTest, EmptyScanFallsBackToOdometryAndIsFlagged) {
+  const auto world = testing::IrregularRoom();
+  ScanOptions options;
+  const Drive drive =
+      MakeDrive(world, 4, Pose2(0.1, 0.0, 0.0), Pose2(0.0, -1.0, 0.0), Pose2(), options, 1);
+  ScanOdometry odometry;
+  odometry.Add(drive.scans[0]);
+  odometry.Add(drive.scans[1]);
+  LaserScan blind = drive.scans[2];
+  std::fill(blind.valid.begin(), blind.valid.end(), std::uint8_t{0});
+  const ScanOdometryResult result = odometry.Add(blind);
+  EXPECT_EQ(result.status, ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_TRUE(result.fell_back);
+  EXPECT_FALSE(result.converged);
+  EXPECT_NEAR(result.T_world_robot.x, result.T_world_robot_odometry_prediction.x, 1e-12);
+  EXPECT_FALSE(result.keyframe);
+  // The next normal scan registers again.
+  const ScanOdometryResult next = odometry.Add(drive.scans[3]);
+  EXPECT_EQ(next.status, ScanOdometryStatus::kRegistered);
+
+  // A first scan without any point: no crash, the next scans fall back until a map exists.
+  ScanOdometry fresh;
+  LaserScan empty;
+  EXPECT_EQ(fresh.Add(empty).status, ScanOdometryStatus::kFirstScan);
+  EXPECT_EQ(fresh.Add(empty).status, ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_EQ(fresh.Add(drive.scans[0]).status, ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_EQ(fresh.Add(drive.scans[1]).status, ScanOdometryStatus::kRegistered);
+}
+
+TEST(ScanOdometryTest, InvalidConfigThrowsNamingTheField) {
+  ScanOdometryConfig config;
+  config.local_map_scans = 0;
+  try {
+    ScanOdometry odometry(config);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("local_map_scans"), std::string::npos);
+  }
+  ScanOdometryConfig icp_bad;
+  icp_bad.icp.kernel_scale_m = 0.0;
+  try {
+    ScanOdometry odometry(icp_bad);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("icp"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("kernel_scale_m"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace keyplace
