@@ -1,0 +1,40 @@
+#pragma once
+// The global map M: the list of submaps of a log (paper Section 3.2), with what made it.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "keyplace/mapping/mapping_config.hpp"
+#include "keyplace/mapping/submap.hpp"
+
+namespace keyplace {
+
+struct GlobalMap {
+  std::vector<Submap> submaps;
+  MappingConfig config;
+  std::string source_log;        // file name of the log the map was built from
+  std::string source_hash;       // "crc32:<hex>:<bytes>" of that file
+  std::string pose_source;       // corrected | odometry | icp
+  std::size_t source_scans = 0;  // scans in the log
+  // FLIRT keypoints of all the scans of the log: the denominator of the compression ratio.
+  std::size_t source_keypoints = 0;
+
+  std::size_t KeypointCount() const;
+};
+
+/// Mapping quality criteria of Section 5.1.
+struct MappingStats {
+  double compression = 0.0;           // stable keypoints in the map / keypoints of all scans
+  double scans_per_submap = 0.0;      // mean
+  double keypoints_per_submap = 0.0;  // mean
+  double distribution = 0.0;          // mean delta
+  std::size_t submaps = 0;
+  std::size_t forced_submaps = 0;  // closed by max_scans_per_submap
+  std::size_t stable_keypoints = 0;
+  std::size_t source_keypoints = 0;
+};
+
+MappingStats ComputeStats(const GlobalMap& map);
+
+}  // namespace keyplace

@@ -1,0 +1,62 @@
+#pragma once
+// Local mapping (paper Algorithm 1): builds one submap from consecutive registered scans.
+
+#include <cstdint>
+#include <unordered_set>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/keypoint.hpp"
+#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/mapping/mapping_config.hpp"
+#include "keyplace/mapping/stability_grid.hpp"
+#include "keyplace/mapping/submap.hpp"
+
+namespace keyplace {
+
+/// Spatial distribution distance delta (Eq. 8): symmetric chi2 between the normalised binary
+/// histograms, on a grid of `cell_m`, of the laser points and of the keypoints. In [0, 1].
+double DistributionDistance(const std::vector<Eigen::Vector2d>& laser_points_m,
+                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m);
+
+class LocalMapper {
+ public:
+  explicit LocalMapper(const MappingConfig& config = {});
+
+  /// Starts a new, empty submap.
+  void Reset();
+
+  /// Adds the next scan: its laser data, the robot pose T_world_robot and its keypoints (laser
+  /// frame). Runs UpdateG and UpdateS; returns true when the submap is complete after this scan.
+  bool AddScan(int scan_index, const LaserScan& scan, const Pose2& T_world_robot,
+               const std::vector<Keypoint>& keypoints);
+
+  /// The submap as it stands (F from the latest UpdateS).
+  Submap Snapshot() const;
+
+  std::size_t scan_count() const { return poses_.size(); }
+  std::size_t stable_count() const { return stable_.size(); }
+  double overlap() const { return overlap_; }
+  double distribution() const { return distribution_; }
+  bool complete() const { return complete_; }
+  bool forced() const { return forced_; }
+  const StabilityGrid& grid() const { return grid_; }
+
+ private:
+  void UpdateCompletion();
+  std::int64_t OverlapCellCount() const;
+
+  MappingConfig config_;
+  StabilityGrid grid_;
+  std::vector<int> scan_indices_;
+  std::vector<Pose2> poses_;
+  std::vector<StabilityGrid::Selected> stable_;
+  std::unordered_set<std::int64_t> laser_cells_;  // cells of D holding a hit cell of G
+  std::int64_t initial_cells_ = 0;
+  double overlap_ = 1.0;
+  double distribution_ = 1.0;
+  bool complete_ = false;
+  bool forced_ = false;
+};
+
+}  // namespace keyplace

@@ -1,0 +1,55 @@
+#pragma once
+// Parameters of stable-keypoint mapping (paper Section 3, defaults from Table V and Section 5.2).
+
+namespace keyplace {
+
+struct MappingConfig {
+  // --- stability grid G (Section 3.1.1)
+  double cell_size_m = 0.10;           // l_g: side of a cell of G
+  double min_stability = 0.3;          // s_min: a cell's keypoint is stable when s >= s_min
+  int min_scan_count = 4;              // ns_min: s = d * occ / max(ns, ns_min)
+  double descriptor_match_chi2 = 0.4;  // similar descriptors: symmetric chi2 below this
+
+  // Which member of a history cluster a new keypoint is compared with. The paper says "look for a
+  // match with keypoints in every history cluster": kAnyMember joins the first (largest) cluster
+  // holding any keypoint within descriptor_match_chi2; kLatestMember compares with the cluster's
+  // most recent keypoint only (cheaper, and follows a slowly changing descriptor).
+  enum class ClusterMatch { kAnyMember, kLatestMember };
+  ClusterMatch cluster_match = ClusterMatch::kAnyMember;
+
+  // --- submap completion (Sections 3.1.3 and 5.2)
+  double min_overlap = 0.75;  // rho_min: complete once rho = a_int / a_uni < rho_min
+  // Cells that make the binary occupancy grids of rho: kHit = cells some beam ended in (the
+  // occupied cells), kObserved = cells some beam ended in or crossed (the seen area).
+  enum class OverlapCells { kHit, kObserved };
+  OverlapCells overlap_cells = OverlapCells::kHit;
+  bool use_distribution = true;      // also require delta <= max_distribution (Section 5.2)
+  double max_distribution = 0.5;     // delta_max
+  double distribution_cell_m = 0.5;  // l: cell of the grid D of the histograms of delta
+  int min_stable_keypoints = 10;     // and at least this many stable keypoints (Section 5.2)
+  // Safety net absent from the paper: a submap that has not met the criteria after this many
+  // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
+  // submap that cannot be completed, as in the paper).
+  int max_scans_per_submap = 300;
+};
+
+/// Throws std::invalid_argument naming the first invalid field.
+void Validate(const MappingConfig& config);
+
+}  // namespace keyplace
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace keyplace {
+
+/// Every field as (name, text value), in declaration order; enums as lower-case names.
+std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig& config);
+
+/// Sets the named fields of `config` from text. Throws std::invalid_argument naming the key for
+/// an unknown key or a value that does not parse. The result is validated.
+void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config);
+
+}  // namespace keyplace

@@ -1,0 +1,123 @@
+#pragma once
+// The stability grid G of a submap under construction (paper Section 3.1.1, Eq. 1-5).
+// Each cell counts beam hits h and misses m (ray casting), the number of scans ns that hit it,
+// and keeps the history H of the keypoints that fell in it, grouped into clusters of similar
+// descriptors sorted by decreasing size. Everything is in the submap frame.
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "keyplace/features/keypoint.hpp"
+#include "keyplace/mapping/mapping_config.hpp"
+
+namespace keyplace {
+
+/// Integer cell coordinates of G (column i along x, row j along y).
+struct CellIndex {
+  int i = 0;
+  int j = 0;
+  bool operator==(const CellIndex& other) const { return i == other.i && j == other.j; }
+};
+
+struct CellCounts {
+  std::int32_t hits = 0;        // h: beams that ended in the cell
+  std::int32_t misses = 0;      // m: beams that crossed the cell without ending in it
+  std::int32_t scans_hit = 0;   // ns: scans with at least one hit in the cell
+  std::int32_t last_scan = -1;  // scan id of the latest hit (to count ns once per scan)
+};
+
+/// A keypoint of some scan, expressed in the submap frame.
+struct GridKeypoint {
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  double orientation_rad = 0.0;
+  double scale_m = 0.0;
+  int scale_level = 0;
+  int scan_index = 0;  // index of the scan in the log
+  BetaGridDescriptor descriptor{};
+};
+
+class StabilityGrid {
+ public:
+  explicit StabilityGrid(const MappingConfig& config);
+
+  void Clear();
+
+  /// UpdateG's counters: ray-casts each endpoint from `origin_m` (both in the submap frame). The
+  /// endpoint's cell gets a hit, every other cell the ray crosses a miss. `scan_id` must grow.
+  void InsertRays(const Eigen::Vector2d& origin_m, const std::vector<Eigen::Vector2d>& endpoints_m,
+                  int scan_id);
+
+  /// UpdateG's history: puts the keypoint into the cluster of its cell it matches (largest
+  /// first), or into a new cluster; keeps clusters sorted by decreasing size (stable).
+  void InsertKeypoint(const GridKeypoint& keypoint);
+
+  CellIndex CellOf(const Eigen::Vector2d& point_m) const;
+  Eigen::Vector2d CellCenter(const CellIndex& cell) const;
+  /// Counters of a cell (all zero outside the grown area).
+  CellCounts Counts(const CellIndex& cell) const;
+
+  /// Stability s = d * occ / max(ns, ns_min) of a cell, with d = h / (h + m) and occ the size of
+  /// its largest history cluster (0 for a cell without keypoints).
+  double Stability(const CellIndex& cell) const;
+
+  /// UpdateS's selection: for every cell with a history and s >= s_min, the most recent keypoint
+  /// of its largest cluster, in the order the cells first received a keypoint.
+  struct Selected {
+    GridKeypoint keypoint;
+    double stability = 0.0;
+    int occurrences = 0;  // occ
+  };
+  std::vector<Selected> SelectStable() const;
+
+  /// History clusters of a cell (each a list of keypoints, oldest first), largest cluster first.
+  std::vector<std::vector<GridKeypoint>> Clusters(const CellIndex& cell) const;
+
+  /// Number of cells hit by at least one beam / hit or crossed by at least one beam.
+  std::int64_t hit_cell_count() const { return hit_cells_; }
+  std::int64_t observed_cell_count() const { return observed_cells_; }
+
+  /// Cells hit by at least one beam.
+  std::vector<CellIndex> HitCells() const;
+  /// Cells whose first hit came from the latest InsertRays call.
+  const std::vector<CellIndex>& newly_hit_cells() const { return newly_hit_cells_; }
+
+  double cell_size_m() const { return cell_size_m_; }
+
+ private:
+  struct Cluster {
+    std::vector<int> members;  // indices into keypoints_, oldest first
+  };
+  struct History {
+    CellIndex cell;
+    std::vector<Cluster> clusters;  // sorted by decreasing size
+  };
+
+  void EnsureCovers(int min_i, int min_j, int max_i, int max_j);
+  CellCounts& At(int i, int j) { return counts_[(j - origin_j_) * width_ + (i - origin_i_)]; }
+  void AddMiss(int i, int j);
+  void AddHit(int i, int j, int scan_id);
+  static std::int64_t Key(const CellIndex& cell) {
+    return (static_cast<std::int64_t>(cell.i) << 32) ^ static_cast<std::uint32_t>(cell.j);
+  }
+
+  MappingConfig config_;
+  double cell_size_m_;
+  // Dense counters over the grown bounding box [origin, origin + size).
+  int origin_i_ = 0;
+  int origin_j_ = 0;
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<CellCounts> counts_;
+  std::int64_t hit_cells_ = 0;
+  std::int64_t observed_cells_ = 0;
+  std::vector<CellIndex> newly_hit_cells_;
+
+  std::vector<GridKeypoint> keypoints_;
+  std::vector<History> histories_;  // in the order cells first received a keypoint
+  std::unordered_map<std::int64_t, int> history_of_cell_;
+};
+
+}  // namespace keyplace

@@ -1,0 +1,150 @@
+#include "keyplace/mapping/local_mapper.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace keyplace {
+namespace {
+
+std::int64_t DistributionKey(const Eigen::Vector2d& point_m, double cell_m) {
+  const auto i = static_cast<std::int64_t>(std::floor(point_m.x() / cell_m));
+  const auto j = static_cast<std::int64_t>(std::floor(point_m.y() / cell_m));
+  return (i << 32) ^ static_cast<std::uint32_t>(j);
+}
+
+// delta from the two sets of occupied cells of D; every keypoint cell normally holds laser
+// points too (keypoints are beam endpoints), but the formula does not rely on it.
+double DistributionFromCells(const std::unordered_set<std::int64_t>& laser_cells,
+                             const std::unordered_set<std::int64_t>& keypoint_cells) {
+  if (keypoint_cells.empty() || laser_cells.empty()) return 1.0;
+  const double q = 1.0 / static_cast<double>(laser_cells.size());
+  const double p = 1.0 / static_cast<double>(keypoint_cells.size());
+  double distance = 0.0;
+  std::size_t shared = 0;
+  for (const auto cell : keypoint_cells) {
+    if (laser_cells.count(cell) != 0) {
+      ++shared;
+      distance += 0.5 * (q - p) * (q - p) / (q + p);
+    } else {
+      distance += 0.5 * p;
+    }
+  }
+  distance += 0.5 * q * static_cast<double>(laser_cells.size() - shared);
+  return distance;
+}
+
+}  // namespace
+
+double DistributionDistance(const std::vector<Eigen::Vector2d>& laser_points_m,
+                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m) {
+  std::unordered_set<std::int64_t> laser_cells;
+  std::unordered_set<std::int64_t> keypoint_cells;
+  for (const auto& point : laser_points_m) laser_cells.insert(DistributionKey(point, cell_m));
+  for (const auto& point : keypoints_m) keypoint_cells.insert(DistributionKey(point, cell_m));
+  return DistributionFromCells(laser_cells, keypoint_cells);
+}
+
+LocalMapper::LocalMapper(const MappingConfig& config) : config_(config), grid_(config) {}
+
+void LocalMapper::Reset() {
+  grid_.Clear();
+  scan_indices_.clear();
+  poses_.clear();
+  stable_.clear();
+  laser_cells_.clear();
+  initial_cells_ = 0;
+  overlap_ = 1.0;
+  distribution_ = 1.0;
+  complete_ = false;
+  forced_ = false;
+}
+
+bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_world_robot,
+                          const std::vector<Keypoint>& keypoints) {
+  const bool first = poses_.empty();
+  scan_indices_.push_back(scan_index);
+  poses_.push_back(T_world_robot);
+  const Pose2 T_submap_laser = Between(poses_.front(), T_world_robot) * scan.T_robot_laser;
+
+  // UpdateG: counters by ray casting, then the keypoint histories.
+  std::vector<Eigen::Vector2d> endpoints_m;
+  endpoints_m.reserve(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (scan.valid[i] != 0) endpoints_m.push_back(T_submap_laser * scan.Endpoint(i));
+  }
+  grid_.InsertRays(T_submap_laser.translation(), endpoints_m, static_cast<int>(poses_.size()) - 1);
+  for (const auto& cell : grid_.newly_hit_cells()) {
+    laser_cells_.insert(DistributionKey(grid_.CellCenter(cell), config_.distribution_cell_m));
+  }
+  for (const Keypoint& keypoint : keypoints) {
+    GridKeypoint grid_keypoint;
+    grid_keypoint.position_m = T_submap_laser * keypoint.position_m;
+    grid_keypoint.orientation_rad = WrapAngle(keypoint.orientation_rad + T_submap_laser.theta);
+    grid_keypoint.scale_m = keypoint.scale_m;
+    grid_keypoint.scale_level = keypoint.scale_level;
+    grid_keypoint.scan_index = scan_index;
+    grid_keypoint.descriptor = keypoint.descriptor;
+    grid_.InsertKeypoint(grid_keypoint);
+  }
+  if (first) initial_cells_ = OverlapCellCount();
+
+  // UpdateS: F is overwritten with the current stable keypoints.
+  stable_ = grid_.SelectStable();
+  UpdateCompletion();
+  return complete_;
+}
+
+std::int64_t LocalMapper::OverlapCellCount() const {
+  return config_.overlap_cells == MappingConfig::OverlapCells::kHit ? grid_.hit_cell_count()
+                                                                    : grid_.observed_cell_count();
+}
+
+void LocalMapper::UpdateCompletion() {
+  // Cells are never removed from the binary grid, so the initial grid is a subset of the current
+  // one: a_int = initial cells, a_uni = current cells.
+  const std::int64_t current = OverlapCellCount();
+  overlap_ = current > 0 ? static_cast<double>(initial_cells_) / static_cast<double>(current) : 1.0;
+  std::unordered_set<std::int64_t> keypoint_cells;
+  for (const auto& selected : stable_) {
+    keypoint_cells.insert(
+        DistributionKey(selected.keypoint.position_m, config_.distribution_cell_m));
+  }
+  distribution_ = DistributionFromCells(laser_cells_, keypoint_cells);
+  complete_ = overlap_ < config_.min_overlap &&
+              (!config_.use_distribution || distribution_ <= config_.max_distribution) &&
+              static_cast<int>(stable_.size()) >= config_.min_stable_keypoints;
+  if (!complete_ && config_.max_scans_per_submap > 0 &&
+      static_cast<int>(poses_.size()) >= config_.max_scans_per_submap) {
+    complete_ = true;
+    forced_ = true;
+  }
+}
+
+Submap LocalMapper::Snapshot() const {
+  Submap submap;
+  submap.scan_indices = scan_indices_;
+  submap.poses = poses_;
+  submap.keypoints.reserve(stable_.size());
+  for (const auto& selected : stable_) {
+    StableKeypoint keypoint;
+    keypoint.position_m = selected.keypoint.position_m;
+    keypoint.orientation_rad = selected.keypoint.orientation_rad;
+    keypoint.scale_m = selected.keypoint.scale_m;
+    keypoint.scale_level = selected.keypoint.scale_level;
+    keypoint.scan_index = selected.keypoint.scan_index;
+    keypoint.stability = static_cast<float>(selected.stability);
+    keypoint.occurrences = selected.occurrences;
+    keypoint.descriptor = selected.keypoint.descriptor;
+    submap.keypoints.push_back(keypoint);
+  }
+  submap.occupancy.cell_size_m = grid_.cell_size_m();
+  for (const auto& cell : grid_.HitCells()) submap.occupancy.cells.emplace_back(cell.i, cell.j);
+  submap.overlap = overlap_;
+  submap.distribution = distribution_;
+  submap.forced = forced_;
+  return submap;
+}
+
+}  // namespace keyplace

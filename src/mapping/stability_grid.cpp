@@ -1,0 +1,234 @@
+#include "keyplace/mapping/stability_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "keyplace/features/descriptor.hpp"
+
+namespace keyplace {
+namespace {
+
+constexpr int kGrowthMarginCells = 64;
+
+}  // namespace
+
+StabilityGrid::StabilityGrid(const MappingConfig& config)
+    : config_(config), cell_size_m_(config.cell_size_m) {
+  Validate(config_);
+}
+
+void StabilityGrid::Clear() {
+  origin_i_ = origin_j_ = width_ = height_ = 0;
+  counts_.clear();
+  hit_cells_ = observed_cells_ = 0;
+  newly_hit_cells_.clear();
+  keypoints_.clear();
+  histories_.clear();
+  history_of_cell_.clear();
+}
+
+CellIndex StabilityGrid::CellOf(const Eigen::Vector2d& point_m) const {
+  return {static_cast<int>(std::floor(point_m.x() / cell_size_m_)),
+          static_cast<int>(std::floor(point_m.y() / cell_size_m_))};
+}
+
+Eigen::Vector2d StabilityGrid::CellCenter(const CellIndex& cell) const {
+  return {(cell.i + 0.5) * cell_size_m_, (cell.j + 0.5) * cell_size_m_};
+}
+
+CellCounts StabilityGrid::Counts(const CellIndex& cell) const {
+  if (cell.i < origin_i_ || cell.j < origin_j_ || cell.i >= origin_i_ + width_ ||
+      cell.j >= origin_j_ + height_) {
+    return {};
+  }
+  return counts_[(cell.j - origin_j_) * width_ + (cell.i - origin_i_)];
+}
+
+void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
+  if (width_ > 0 && min_i >= origin_i_ && min_j >= origin_j_ && max_i < origin_i_ + width_ &&
+      max_j < origin_j_ + height_) {
+    return;
+  }
+  int new_min_i = min_i - kGrowthMarginCells;
+  int new_min_j = min_j - kGrowthMarginCells;
+  int new_max_i = max_i + kGrowthMarginCells;
+  int new_max_j = max_j + kGrowthMarginCells;
+  if (width_ > 0) {
+    new_min_i = std::min(new_min_i, origin_i_);
+    new_min_j = std::min(new_min_j, origin_j_);
+    new_max_i = std::max(new_max_i, origin_i_ + width_ - 1);
+    new_max_j = std::max(new_max_j, origin_j_ + height_ - 1);
+  }
+  const int new_width = new_max_i - new_min_i + 1;
+  const int new_height = new_max_j - new_min_j + 1;
+  std::vector<CellCounts> grown(static_cast<std::size_t>(new_width) * new_height);
+  for (int j = 0; j < height_; ++j) {
+    const int target_row = j + origin_j_ - new_min_j;
+    std::copy_n(counts_.begin() + static_cast<std::ptrdiff_t>(j) * width_, width_,
+                grown.begin() + static_cast<std::ptrdiff_t>(target_row) * new_width +
+                    (origin_i_ - new_min_i));
+  }
+  counts_ = std::move(grown);
+  origin_i_ = new_min_i;
+  origin_j_ = new_min_j;
+  width_ = new_width;
+  height_ = new_height;
+}
+
+void StabilityGrid::AddMiss(int i, int j) {
+  CellCounts& cell = At(i, j);
+  if (cell.hits == 0 && cell.misses == 0) ++observed_cells_;
+  ++cell.misses;
+}
+
+void StabilityGrid::AddHit(int i, int j, int scan_id) {
+  CellCounts& cell = At(i, j);
+  if (cell.hits == 0) {
+    ++hit_cells_;
+    newly_hit_cells_.push_back({i, j});
+    if (cell.misses == 0) ++observed_cells_;
+  }
+  ++cell.hits;
+  if (cell.last_scan != scan_id) {
+    cell.last_scan = scan_id;
+    ++cell.scans_hit;
+  }
+}
+
+void StabilityGrid::InsertRays(const Eigen::Vector2d& origin_m,
+                               const std::vector<Eigen::Vector2d>& endpoints_m, int scan_id) {
+  newly_hit_cells_.clear();
+  if (endpoints_m.empty()) return;
+  const CellIndex start = CellOf(origin_m);
+  int min_i = start.i, max_i = start.i, min_j = start.j, max_j = start.j;
+  for (const auto& endpoint : endpoints_m) {
+    const CellIndex cell = CellOf(endpoint);
+    min_i = std::min(min_i, cell.i);
+    max_i = std::max(max_i, cell.i);
+    min_j = std::min(min_j, cell.j);
+    max_j = std::max(max_j, cell.j);
+  }
+  EnsureCovers(min_i, min_j, max_i, max_j);
+
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& endpoint : endpoints_m) {
+    // Amanatides-Woo traversal of the cells between the origin and the endpoint.
+    const CellIndex end = CellOf(endpoint);
+    int i = start.i;
+    int j = start.j;
+    const double dx = endpoint.x() - origin_m.x();
+    const double dy = endpoint.y() - origin_m.y();
+    const int step_i = dx > 0 ? 1 : -1;
+    const int step_j = dy > 0 ? 1 : -1;
+    const double next_x = (i + (step_i > 0 ? 1 : 0)) * cell_size_m_;
+    const double next_y = (j + (step_j > 0 ? 1 : 0)) * cell_size_m_;
+    double t_max_x = dx != 0.0 ? (next_x - origin_m.x()) / dx : inf;
+    double t_max_y = dy != 0.0 ? (next_y - origin_m.y()) / dy : inf;
+    const double t_delta_x = dx != 0.0 ? cell_size_m_ / std::abs(dx) : inf;
+    const double t_delta_y = dy != 0.0 ? cell_size_m_ / std::abs(dy) : inf;
+    // Rounding can miss the end cell by one step; never walk further than the Manhattan distance.
+    int steps_left = std::abs(end.i - i) + std::abs(end.j - j);
+    while ((i != end.i || j != end.j) && steps_left-- > 0) {
+      AddMiss(i, j);
+      if (t_max_x < t_max_y) {
+        t_max_x += t_delta_x;
+        i += step_i;
+      } else {
+        t_max_y += t_delta_y;
+        j += step_j;
+      }
+    }
+    AddHit(end.i, end.j, scan_id);
+  }
+}
+
+void StabilityGrid::InsertKeypoint(const GridKeypoint& keypoint) {
+  const CellIndex cell = CellOf(keypoint.position_m);
+  const int index = static_cast<int>(keypoints_.size());
+  keypoints_.push_back(keypoint);
+  auto [it, inserted] = history_of_cell_.emplace(Key(cell), static_cast<int>(histories_.size()));
+  if (inserted) histories_.push_back({cell, {}});
+  History& history = histories_[it->second];
+
+  const auto matches = [&](const Cluster& cluster) {
+    if (config_.cluster_match == MappingConfig::ClusterMatch::kLatestMember) {
+      return SymmetricChi2Below(keypoints_[cluster.members.back()].descriptor, keypoint.descriptor,
+                                config_.descriptor_match_chi2);
+    }
+    return std::any_of(cluster.members.begin(), cluster.members.end(), [&](int member) {
+      return SymmetricChi2Below(keypoints_[member].descriptor, keypoint.descriptor,
+                                config_.descriptor_match_chi2);
+    });
+  };
+  std::size_t target = history.clusters.size();
+  for (std::size_t c = 0; c < history.clusters.size(); ++c) {
+    if (matches(history.clusters[c])) {
+      target = c;
+      break;
+    }
+  }
+  if (target == history.clusters.size()) {
+    history.clusters.push_back({{index}});
+    return;
+  }
+  history.clusters[target].members.push_back(index);
+  // Keep decreasing size: bubble the grown cluster up past smaller ones (ties keep their order).
+  while (target > 0 &&
+         history.clusters[target - 1].members.size() < history.clusters[target].members.size()) {
+    std::swap(history.clusters[target - 1], history.clusters[target]);
+    --target;
+  }
+}
+
+double StabilityGrid::Stability(const CellIndex& cell) const {
+  const auto it = history_of_cell_.find(Key(cell));
+  if (it == history_of_cell_.end() || histories_[it->second].clusters.empty()) return 0.0;
+  const CellCounts counts = Counts(cell);
+  const int total = counts.hits + counts.misses;
+  if (total == 0) return 0.0;
+  const double density = static_cast<double>(counts.hits) / total;
+  const double occurrences =
+      static_cast<double>(histories_[it->second].clusters.front().members.size());
+  return density * occurrences / std::max(counts.scans_hit, config_.min_scan_count);
+}
+
+std::vector<StabilityGrid::Selected> StabilityGrid::SelectStable() const {
+  std::vector<Selected> selected;
+  for (const History& history : histories_) {
+    if (history.clusters.empty()) continue;
+    const double stability = Stability(history.cell);
+    if (stability < config_.min_stability) continue;
+    const Cluster& largest = history.clusters.front();
+    selected.push_back(
+        {keypoints_[largest.members.back()], stability, static_cast<int>(largest.members.size())});
+  }
+  return selected;
+}
+
+std::vector<std::vector<GridKeypoint>> StabilityGrid::Clusters(const CellIndex& cell) const {
+  std::vector<std::vector<GridKeypoint>> clusters;
+  const auto it = history_of_cell_.find(Key(cell));
+  if (it == history_of_cell_.end()) return clusters;
+  for (const Cluster& cluster : histories_[it->second].clusters) {
+    std::vector<GridKeypoint> members;
+    for (const int member : cluster.members) members.push_back(keypoints_[member]);
+    clusters.push_back(std::move(members));
+  }
+  return clusters;
+}
+
+std::vector<CellIndex> StabilityGrid::HitCells() const {
+  std::vector<CellIndex> cells;
+  cells.reserve(static_cast<std::size_t>(hit_cells_));
+  for (int j = 0; j < height_; ++j) {
+    for (int i = 0; i < width_; ++i) {
+      if (counts_[static_cast<std::size_t>(j) * width_ + i].hits > 0) {
+        cells.push_back({i + origin_i_, j + origin_j_});
+      }
+    }
+  }
+  return cells;
+}
+
+}  // namespace keyplace

@@ -1,0 +1,165 @@
+#include "keyplace/mapping/stability_grid.hpp"
+
+#include <gtest/gtest.h>
+
+#include "keyplace/features/descriptor.hpp"
+
+namespace keyplace {
+namespace {
+
+MappingConfig UnitCells() {
+  MappingConfig config;
+  config.cell_size_m = 1.0;  // easy hand computation
+  return config;
+}
+
+BetaGridDescriptor Uniform() {
+  BetaGridDescriptor d;
+  d.fill(1.0f / kBetaGridBins);
+  return d;
+}
+
+// Mass w in bin 0 and 1 - w in bin 1: chi2(Mix(1), Mix(0.5)) = 1/3 < 0.4 but chi2(Mix(1),
+// Mix(0)) = 1, and chi2(Mix(1), Uniform()) is about 0.96.
+BetaGridDescriptor Mix(float w) {
+  BetaGridDescriptor d{};
+  d[0] = w;
+  d[1] = 1.0f - w;
+  return d;
+}
+BetaGridDescriptor Peaked(float tweak = 0.0f) { return Mix(1.0f - tweak); }
+
+GridKeypoint At(double x, double y, int scan, const BetaGridDescriptor& descriptor) {
+  GridKeypoint keypoint;
+  keypoint.position_m = {x, y};
+  keypoint.scan_index = scan;
+  keypoint.descriptor = descriptor;
+  return keypoint;
+}
+
+TEST(StabilityGrid, StraightRayCountsMissesThenHit) {
+  StabilityGrid grid(UnitCells());
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}}, 0);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(grid.Counts({i, 0}).misses, 1) << i;
+    EXPECT_EQ(grid.Counts({i, 0}).hits, 0) << i;
+  }
+  EXPECT_EQ(grid.Counts({3, 0}).hits, 1);
+  EXPECT_EQ(grid.Counts({3, 0}).misses, 0);
+  EXPECT_EQ(grid.Counts({3, 0}).scans_hit, 1);
+  EXPECT_EQ(grid.Counts({4, 0}).hits + grid.Counts({4, 0}).misses, 0);
+  EXPECT_EQ(grid.hit_cell_count(), 1);
+  EXPECT_EQ(grid.observed_cell_count(), 4);
+}
+
+TEST(StabilityGrid, DiagonalRayVisitsCellsInCrossingOrder) {
+  StabilityGrid grid(UnitCells());
+  // From (0.5, 0.5) to (2.5, 1.5): crosses x = 1 at t = 0.25, y = 1 at t = 0.5, x = 2 at 0.75.
+  grid.InsertRays({0.5, 0.5}, {{2.5, 1.5}}, 0);
+  EXPECT_EQ(grid.Counts({0, 0}).misses, 1);
+  EXPECT_EQ(grid.Counts({1, 0}).misses, 1);
+  EXPECT_EQ(grid.Counts({1, 1}).misses, 1);
+  EXPECT_EQ(grid.Counts({2, 1}).hits, 1);
+  EXPECT_EQ(grid.Counts({0, 1}).misses, 0);
+  EXPECT_EQ(grid.Counts({2, 0}).misses, 0);
+}
+
+TEST(StabilityGrid, ScansHitCountsEachScanOnce) {
+  StabilityGrid grid(UnitCells());
+  grid.InsertRays({0.5, 0.5}, {{3.2, 0.5}, {3.8, 0.7}}, 0);  // two beams of one scan
+  EXPECT_EQ(grid.Counts({3, 0}).hits, 2);
+  EXPECT_EQ(grid.Counts({3, 0}).scans_hit, 1);
+  grid.InsertRays({-5.5, 0.5}, {{3.5, 0.5}}, 1);  // grows the grid to negative cells
+  EXPECT_EQ(grid.Counts({3, 0}).hits, 3);
+  EXPECT_EQ(grid.Counts({3, 0}).scans_hit, 2);
+  EXPECT_EQ(grid.Counts({-6, 0}).misses, 1);
+  EXPECT_EQ(grid.Counts({0, 0}).misses, 3);  // two beams of scan 0, one of scan 1
+}
+
+TEST(StabilityGrid, ClustersGroupSimilarDescriptorsLargestFirst) {
+  StabilityGrid grid(UnitCells());
+  ASSERT_GT(SymmetricChi2(Uniform(), Peaked()), 0.4);
+  ASSERT_LT(SymmetricChi2(Peaked(), Peaked(0.01f)), 0.4);
+  grid.InsertKeypoint(At(3.5, 0.5, 0, Uniform()));
+  grid.InsertKeypoint(At(3.4, 0.6, 1, Peaked()));
+  auto clusters = grid.Clusters({3, 0});
+  ASSERT_EQ(clusters.size(), 2u);
+  EXPECT_EQ(clusters[0][0].scan_index, 0);  // equal sizes keep their order
+  grid.InsertKeypoint(At(3.6, 0.4, 2, Peaked(0.01f)));
+  clusters = grid.Clusters({3, 0});
+  ASSERT_EQ(clusters.size(), 2u);
+  ASSERT_EQ(clusters[0].size(), 2u);  // the peaked cluster grew and moved first
+  EXPECT_EQ(clusters[0][0].scan_index, 1);
+  EXPECT_EQ(clusters[0][1].scan_index, 2);
+  EXPECT_EQ(clusters[1][0].scan_index, 0);
+  EXPECT_TRUE(grid.Clusters({0, 0}).empty());
+}
+
+TEST(StabilityGrid, StabilityAndSelectionMatchHandComputation) {
+  StabilityGrid grid(UnitCells());
+  // Cell (3, 0): 3 hits in 3 scans and 1 miss (a ray to (5.5, 0.5) crosses it).
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}}, 0);
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}}, 1);
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}, {5.5, 0.5}}, 2);
+  ASSERT_EQ(grid.Counts({3, 0}).hits, 3);
+  ASSERT_EQ(grid.Counts({3, 0}).misses, 1);
+  ASSERT_EQ(grid.Counts({3, 0}).scans_hit, 3);
+  grid.InsertKeypoint(At(3.5, 0.5, 0, Peaked()));
+  grid.InsertKeypoint(At(3.5, 0.5, 1, Uniform()));
+  grid.InsertKeypoint(At(3.5, 0.5, 2, Peaked(0.01f)));
+  // d = 3/4, occ = 2, ns = max(3, ns_min = 4) = 4: s = 0.75 * 2 / 4 = 0.375.
+  EXPECT_DOUBLE_EQ(grid.Stability({3, 0}), 0.375);
+  // Cell (5, 0): 1 hit, 0 misses, 1 keypoint: s = 1 * 1 / 4 = 0.25 < s_min = 0.3.
+  grid.InsertKeypoint(At(5.5, 0.5, 2, Uniform()));
+  EXPECT_DOUBLE_EQ(grid.Stability({5, 0}), 0.25);
+  const auto selected = grid.SelectStable();
+  ASSERT_EQ(selected.size(), 1u);
+  EXPECT_EQ(selected[0].keypoint.scan_index, 2);  // most recent of the largest cluster
+  EXPECT_EQ(selected[0].occurrences, 2);
+  EXPECT_DOUBLE_EQ(selected[0].stability, 0.375);
+}
+
+TEST(StabilityGrid, LatestMemberMatchingComparesOnlyTheNewestKeypoint) {
+  MappingConfig config = UnitCells();
+  config.cluster_match = MappingConfig::ClusterMatch::kLatestMember;
+  StabilityGrid latest(config);
+  StabilityGrid any(UnitCells());
+  // A chain a -> b -> c where a~b, b~c, but a and c are far apart: with kLatestMember, c joins
+  // (newest b); with kAnyMember it joins as well (b is a member). Then d ~ a only: joins with
+  // kAnyMember (a is a member) but not with kLatestMember (newest is c).
+  const BetaGridDescriptor a = Mix(1.0f), b = Mix(0.5f), c = Mix(0.0f);
+  ASSERT_LT(SymmetricChi2(a, b), 0.4);
+  ASSERT_LT(SymmetricChi2(b, c), 0.4);
+  for (auto* grid : {&latest, &any}) {
+    grid->InsertKeypoint(At(0.5, 0.5, 0, a));
+    grid->InsertKeypoint(At(0.5, 0.5, 1, b));
+    grid->InsertKeypoint(At(0.5, 0.5, 2, c));
+  }
+  const BetaGridDescriptor d = Mix(1.0f);
+  ASSERT_LT(SymmetricChi2(a, d), 0.4);
+  ASSERT_GT(SymmetricChi2(c, d), 0.4);
+  latest.InsertKeypoint(At(0.5, 0.5, 3, d));
+  any.InsertKeypoint(At(0.5, 0.5, 3, d));
+  EXPECT_EQ(latest.Clusters({0, 0}).size(), 2u);
+  EXPECT_EQ(any.Clusters({0, 0}).size(), 1u);
+}
+
+TEST(MappingConfig, RejectsInvalidFieldsByName) {
+  MappingConfig config;
+  config.cell_size_m = 0.0;
+  try {
+    StabilityGrid grid(config);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("cell_size_m"), std::string::npos);
+  }
+  MappingConfig parsed;
+  EXPECT_THROW(ApplyKeyValues({{"no_such_key", "1"}}, parsed), std::invalid_argument);
+  EXPECT_THROW(ApplyKeyValues({{"min_stability", "abc"}}, parsed), std::invalid_argument);
+  ApplyKeyValues({{"min_stability", "0.5"}, {"overlap_cells", "observed"}}, parsed);
+  EXPECT_DOUBLE_EQ(parsed.min_stability, 0.5);
+  EXPECT_EQ(parsed.overlap_cells, MappingConfig::OverlapCells::kObserved);
+}
+
+}  // namespace
+}  // namespace keyplace
