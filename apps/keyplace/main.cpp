@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "keyplace 0.1.0");
   app.require_subcommand(1);
   keyplace::cli::RegisterInfoCommand(app);
+  keyplace::cli::RegisterOdometryCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
