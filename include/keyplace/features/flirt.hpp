@@ -1,0 +1,96 @@
+#pragma once
+// FLIRT interest points for 2D laser scans: FLIRTLib's multi-scale curvature detector on the
+// geodesic graph of the scan, and its beta-grid descriptor (Tipaldi & Arras, ICRA 2010).
+//
+// This is an independent reimplementation that reproduces the output of FLIRTLib
+// (tipaldi/flirtlib @ f608c8c4) with the parameters of its RansacLoopClosureTest; the algorithm,
+// every reproduced quirk and every deviation are described in docs/FLIRT.md.
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/descriptor.hpp"
+#include "keyplace/features/keypoint.hpp"
+#include "keyplace/io/laser_scan.hpp"
+
+namespace keyplace {
+
+struct FlirtConfig {
+  // --- Detector (FLIRTLib CurvatureDetector + SimpleMinMaxPeakFinder) ---
+  int num_scales = 5;                  // number of smoothing scales
+  double base_sigma_m = 0.2;           // sigma of scale 0 (t0 in the paper)
+  double sigma_step = 1.4;             // sigma_l = base_sigma_m * sigma_step^l (ti in the paper)
+  int dmst = 2;                        // the geodesic graph is the union of dmst + 1 spanning trees
+  double min_peak = 0.34;              // a peak needs signal > min_peak (signal = t exp(-t) <= 1/e)
+  double min_peak_difference = 0.001;  // ... and signal - signal of each neighbour > this
+  // A keypoint is dropped when an already accepted one (finer scales first) lies within this
+  // distance along both world axes (FLIRTLib's axis-aligned box; see FlirtExtractor::Extract).
+  double duplicate_box_m = 0.2;
+  // Geodesic neighbours farther than kernel_cutoff_sigmas * sigma are left out of the Gaussian
+  // smoothing at that scale (FLIRTLib sums over all vertices). At 8 sigma a left-out weight is
+  // below exp(-32) = 1.3e-14 of the central one, so the output equals the untruncated one;
+  // +infinity gives the exact all-pairs computation.
+  double kernel_cutoff_sigmas = 8.0;
+
+  // --- Descriptor (FLIRTLib BetaGridGenerator; 12 x 4 bins, see descriptor.hpp) ---
+  double descriptor_min_rho_m = 0.02;        // inner radius of the innermost ring
+  double descriptor_max_rho_m = 0.5;         // outer radius of the outermost ring (not scaled)
+  double descriptor_radial_border_m = 0.05;  // rings overlap by this much (FLIRTLib hard-codes)
+  double descriptor_angular_border_rad = 5.0 * M_PI / 180.0;  // sectors overlap by this much
+};
+
+/// Throws std::invalid_argument naming the first invalid field.
+void ValidateFlirtConfig(const FlirtConfig& config);
+
+/// Intermediate signals of the detector, for diagnostics and oracle tests.
+struct FlirtSignals {
+  std::vector<int> beam_of_vertex;  // graph vertex (valid beam, in scan order) -> beam index
+  std::vector<double> sigma_m;      // per scale
+  // Per scale, per vertex: geodesic-Gaussian smoothed position (laser frame) and the signal
+  // t exp(-t), t = 2 / sigma * |smoothed - position|.
+  std::vector<std::vector<Eigen::Vector2d>> smoothed_m;
+  std::vector<std::vector<double>> signal;
+  std::vector<std::vector<int>> peak_vertices;  // per scale, ascending
+};
+
+/// FLIRT detector + beta-grid descriptor. Immutable after construction; all methods are const
+/// and thread-safe: scratch buffers live in a per-thread workspace that is reused between calls.
+class FlirtExtractor {
+ public:
+  explicit FlirtExtractor(FlirtConfig config = {});
+
+  const FlirtConfig& config() const { return config_; }
+  /// sigma of a scale level (m); the keypoint scale is 2 sigma.
+  double SigmaM(int scale_level) const { return sigmas_m_.at(scale_level); }
+
+  /// Detects and describes the keypoints of one scan, in FLIRTLib's order (scale level
+  /// ascending, then beam order). Positions and orientations are in the laser frame.
+  /// `T_world_laser` only orients FLIRTLib's axis-aligned duplicate-suppression box (the
+  /// original works on world-frame points); pass the laser pose to reproduce FLIRTLib exactly.
+  /// A beam is used when its range is finite, >= 0 and < scan.max_range_m. Scans with fewer than
+  /// 5 such beams give no keypoints. Throws std::invalid_argument when ranges_m and angles_rad
+  /// differ in size.
+  std::vector<Keypoint> Extract(const LaserScan& scan, const Pose2& T_world_laser = Pose2()) const;
+
+  /// Extract without the descriptors (they stay zero).
+  std::vector<Keypoint> Detect(const LaserScan& scan, const Pose2& T_world_laser = Pose2()) const;
+
+  /// Fills the descriptor of each keypoint from the scan it was detected in.
+  void Describe(const LaserScan& scan, std::vector<Keypoint>& keypoints) const;
+
+  /// The beta grid of an arbitrary oriented point (laser frame) in a scan.
+  BetaGridDescriptor Describe(const LaserScan& scan, const Eigen::Vector2d& position_m,
+                              double orientation_rad) const;
+
+  /// The detector's intermediate signals (slow path with copies; for tests and diagnostics).
+  FlirtSignals ComputeSignals(const LaserScan& scan) const;
+
+ private:
+  FlirtConfig config_;
+  std::vector<double> sigmas_m_;
+};
+
+}  // namespace keyplace

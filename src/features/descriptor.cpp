@@ -1,0 +1,38 @@
+#include "keyplace/features/descriptor.hpp"
+
+#include <limits>
+
+namespace keyplace {
+namespace {
+
+// FLIRTLib replaces empty bins by the smallest positive normal double before dividing.
+constexpr double kPseudoZero = std::numeric_limits<double>::min();
+
+inline double Chi2Term(float a, float b) {
+  const double q = a == 0.0f ? kPseudoZero : static_cast<double>(a);
+  const double p = b == 0.0f ? kPseudoZero : static_cast<double>(b);
+  const double diff = q - p;
+  return diff * diff / (q + p);
+}
+
+}  // namespace
+
+double SymmetricChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b) {
+  double sum = 0.0;
+  for (int i = 0; i < kBetaGridBins; ++i) sum += Chi2Term(a[i], b[i]);
+  return 0.5 * sum;
+}
+
+bool SymmetricChi2Below(const BetaGridDescriptor& a, const BetaGridDescriptor& b,
+                        double threshold) {
+  const double limit = 2.0 * threshold;  // compare the raw sum, halve nothing in the loop
+  double sum = 0.0;
+  for (int phi = 0; phi < kBetaGridPhiBins; ++phi) {
+    const int base = phi * kBetaGridRhoBins;
+    for (int rho = 0; rho < kBetaGridRhoBins; ++rho) sum += Chi2Term(a[base + rho], b[base + rho]);
+    if (sum >= limit) return false;
+  }
+  return 0.5 * sum < threshold;
+}
+
+}  // namespace keyplace
