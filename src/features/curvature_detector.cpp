@@ -10,8 +10,9 @@ namespace keyplace::features_internal {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Moves a blocked vertex out of reach for one Prim step: its squared distance overflows to +inf.
-constexpr double kFarAway = 1e200;
+// Squared distance and hypot each carry < 2 ulp of error; this margin keeps every candidate
+// that might be shorter than the current key (only those get the exact hypot comparison).
+constexpr double kBoundSlack = 1.0 + 1e-13;
 
 // Builds a CSR adjacency from an undirected edge list (both directions).
 void BuildCsr(int n, const std::vector<int>& a, const std::vector<int>& b,
@@ -30,9 +31,12 @@ void BuildCsr(int n, const std::vector<int>& a, const std::vector<int>& b,
   }
 }
 
-// One round of Prim's algorithm (root 0) on the complete Euclidean graph minus the edges already
-// taken (and minus the edge (0, n-1)); appends the tree edges to the workspace edge list.
-// Dense O(n^2): compares squared distances, which order the edges exactly like the distances.
+// One round of Prim's algorithm from vertex 0 on the complete Euclidean graph minus the edges
+// already taken (and minus the edge (0, n-1)); appends the tree edges to the workspace edge list
+// (as (parent, vertex) in vertex order, like FLIRTLib). Edge weights are hypot(dx, dy) and the
+// visiting order, comparisons and heap follow Boost's prim_minimum_spanning_tree on an adjacency
+// matrix, so that exactly equal edge lengths -- common with centimetre ranges -- are resolved the
+// same way. Dense O(n^2); a squared-distance test skips the hypot of clearly longer edges.
 void PrimRound(int n, CurvatureWorkspace& ws) {
   // Removed edges = the union so far plus (0, n-1).
   ws.edge_a.push_back(0);
@@ -41,80 +45,71 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
   ws.edge_a.pop_back();
   ws.edge_b.pop_back();
 
-  int m = n - 1;  // vertices not in the tree, at compact positions 0..m-1
-  ws.prim_vertex.resize(n);
+  enum : unsigned char { kWhite, kGray, kBlack };
+  ws.prim_color.assign(n, kWhite);
+  ws.prim_key.assign(n, kInf);
+  ws.prim_key_bound.assign(n, kInf);
   ws.prim_parent.resize(n);
-  ws.prim_position.resize(n);
-  ws.prim_x.resize(n);
-  ws.prim_y.resize(n);
-  ws.prim_key.resize(n);
-  ws.prim_position[0] = -1;
-  for (int v = 1; v < n; ++v) {
-    const int p = v - 1;
-    ws.prim_vertex[p] = v;
-    ws.prim_parent[p] = -1;
-    ws.prim_position[v] = p;
-    ws.prim_x[p] = ws.x[v];
-    ws.prim_y[p] = ws.y[v];
-    ws.prim_key[p] = kInf;
-  }
-  int* vertex = ws.prim_vertex.data();
-  int* parent = ws.prim_parent.data();
-  double* px = ws.prim_x.data();
-  double* py = ws.prim_y.data();
+  ws.prim_removed_mark.assign(n, -1);
+  for (int v = 0; v < n; ++v) ws.prim_parent[v] = v;
+  unsigned char* color = ws.prim_color.data();
   double* key = ws.prim_key.data();
+  double* key_bound = ws.prim_key_bound.data();
+  int* parent = ws.prim_parent.data();
+  int* removed_mark = ws.prim_removed_mark.data();
+  const double* x = ws.x.data();
+  const double* y = ws.y.data();
+  QuaternaryHeap& heap = ws.prim_heap;
+  heap.Reset(n, key);
 
-  int u = 0;
-  while (m > 0) {
-    const double ux = ws.x[u];
-    const double uy = ws.y[u];
-    const int removed_begin = ws.removed_offsets[u];
-    const int removed_end = ws.removed_offsets[u + 1];
-    for (int r = removed_begin; r < removed_end; ++r) {
-      const int p = ws.prim_position[ws.removed_targets[r]];
-      if (p >= 0) px[p] = kFarAway;
+  key[0] = 0.0;
+  color[0] = kGray;
+  heap.Push(0);
+  while (!heap.Empty()) {
+    const int u = heap.Top();
+    heap.Pop();
+    for (int r = ws.removed_offsets[u]; r < ws.removed_offsets[u + 1]; ++r) {
+      removed_mark[ws.removed_targets[r]] = u;
     }
-    double best = kInf;
-    int best_p = -1;
-    for (int p = 0; p < m; ++p) {
-      const double dx = px[p] - ux;
-      const double dy = py[p] - uy;
-      const double d2 = dx * dx + dy * dy;
-      if (d2 < key[p]) {
-        key[p] = d2;
-        parent[p] = u;
+    const double ux = x[u];
+    const double uy = y[u];
+    for (int v = 0; v < n; ++v) {
+      if (v == u || removed_mark[v] == u || color[v] == kBlack) continue;
+      const double dx = x[v] - ux;
+      const double dy = y[v] - uy;
+      if (color[v] == kWhite) {
+        const double weight = std::hypot(dx, dy);
+        if (weight < key[v]) {
+          key[v] = weight;
+          key_bound[v] = weight * weight * kBoundSlack;
+          parent[v] = u;
+        }
+        color[v] = kGray;
+        heap.Push(v);
+      } else if (dx * dx + dy * dy <= key_bound[v]) {
+        const double weight = std::hypot(dx, dy);
+        if (weight < key[v]) {
+          key[v] = weight;
+          key_bound[v] = weight * weight * kBoundSlack;
+          parent[v] = u;
+          heap.DecreaseKey(v);
+        }
       }
-      if (key[p] < best) {
-        best = key[p];
-        best_p = p;
-      }
     }
-    for (int r = removed_begin; r < removed_end; ++r) {
-      const int t = ws.removed_targets[r];
-      const int p = ws.prim_position[t];
-      if (p >= 0) px[p] = ws.x[t];
-    }
-    if (best_p < 0) break;  // the rest is unreachable (only for tiny point sets)
-    const int v = vertex[best_p];
-    ws.edge_a.push_back(parent[best_p]);
+    color[u] = kBlack;
+  }
+  for (int v = 1; v < n; ++v) {
+    if (parent[v] == v) continue;  // unreachable (only in tiny point sets)
+    ws.edge_a.push_back(parent[v]);
     ws.edge_b.push_back(v);
-    // Remove best_p from the compact arrays (swap with the last).
-    const int last = m - 1;
-    vertex[best_p] = vertex[last];
-    parent[best_p] = parent[last];
-    px[best_p] = px[last];
-    py[best_p] = py[last];
-    key[best_p] = key[last];
-    ws.prim_position[vertex[best_p]] = best_p;
-    ws.prim_position[v] = -1;
-    --m;
-    u = v;
   }
 }
 
-// Dijkstra from every vertex on the spanning-tree union, truncated at max_radius. Each row holds
-// the settled vertices in settle order (non-decreasing distance) with their squared distance;
-// row_scale_count[i * L + l] is the length of the prefix within radii[l].
+// Dijkstra from every vertex on the spanning-tree union, truncated at the largest radius. Each
+// row holds the settled vertices in settle order (non-decreasing distance) with their squared
+// distance; row_scale_count[i * L + l] is the length of the prefix within radii[l].
+// The graph is nearly a chain, so the frontier stays small (about 5-10 vertices): an unsorted
+// array with a linear minimum search beats a heap here.
 void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWorkspace& ws) {
   const int num_scales = static_cast<int>(radii.size());
   const double max_radius = radii.back();
@@ -122,36 +117,56 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
   ws.row_scale_count.resize(static_cast<std::size_t>(n) * num_scales);
   ws.row_vertex.clear();
   ws.row_dist2.clear();
-  ws.dijkstra_dist.assign(n, kInf);
-  ws.dijkstra_touched.clear();
+  ws.dijkstra_dist.resize(n);
+  ws.dijkstra_stamp.assign(n, -1);
+  ws.dijkstra_slot.resize(n);
+  ws.frontier_vertex.resize(n);
+  ws.frontier_dist.resize(n);
   double* dist = ws.dijkstra_dist.data();
+  int* stamp = ws.dijkstra_stamp.data();
+  int* slot = ws.dijkstra_slot.data();  // frontier position, or -1 once settled
+  int* frontier_vertex = ws.frontier_vertex.data();
+  double* frontier_dist = ws.frontier_dist.data();
   const int* adj_offsets = ws.adj_offsets.data();
   const int* adj_targets = ws.adj_targets.data();
   const double* adj_weights = ws.adj_weights.data();
-  auto& heap = ws.heap;
-  const auto heap_order = std::greater<std::pair<double, int>>();
 
   for (int source = 0; source < n; ++source) {
     const std::size_t row_begin = ws.row_vertex.size();
+    stamp[source] = source;
     dist[source] = 0.0;
-    ws.dijkstra_touched.push_back(source);
-    heap.clear();
-    heap.emplace_back(0.0, source);
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end(), heap_order);
-      const auto [d, v] = heap.back();
-      heap.pop_back();
-      if (d > dist[v]) continue;  // stale entry
+    slot[source] = 0;
+    frontier_vertex[0] = source;
+    frontier_dist[0] = 0.0;
+    int frontier_size = 1;
+    while (frontier_size > 0) {
+      int best = 0;
+      for (int f = 1; f < frontier_size; ++f) {
+        if (frontier_dist[f] < frontier_dist[best]) best = f;
+      }
+      const int v = frontier_vertex[best];
+      const double d = frontier_dist[best];
+      --frontier_size;
+      frontier_vertex[best] = frontier_vertex[frontier_size];
+      frontier_dist[best] = frontier_dist[frontier_size];
+      slot[frontier_vertex[best]] = best;
+      slot[v] = -1;
       ws.row_vertex.push_back(v);
       ws.row_dist2.push_back(d * d);
       for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
         const int t = adj_targets[e];
         const double nd = d + adj_weights[e];
-        if (nd < dist[t] && nd <= max_radius) {
-          if (dist[t] == kInf) ws.dijkstra_touched.push_back(t);
+        if (nd > max_radius) continue;
+        if (stamp[t] != source) {
+          stamp[t] = source;
           dist[t] = nd;
-          heap.emplace_back(nd, t);
-          std::push_heap(heap.begin(), heap.end(), heap_order);
+          slot[t] = frontier_size;
+          frontier_vertex[frontier_size] = t;
+          frontier_dist[frontier_size] = nd;
+          ++frontier_size;
+        } else if (nd < dist[t] && slot[t] >= 0) {
+          dist[t] = nd;
+          frontier_dist[slot[t]] = nd;
         }
       }
     }
@@ -165,8 +180,6 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
       ws.row_scale_count[static_cast<std::size_t>(source) * num_scales + l] =
           static_cast<int>(k - row_begin);
     }
-    for (const int t : ws.dijkstra_touched) dist[t] = kInf;
-    ws.dijkstra_touched.clear();
   }
 }
 
@@ -184,7 +197,7 @@ void ComputeCurvature(const CurvatureParams& params, CurvatureWorkspace& ws,
   ws.edge_a.clear();
   ws.edge_b.clear();
   for (int round = 0; round < params.num_trees; ++round) PrimRound(n, ws);
-  ws.edge_weight.resize(ws.edge_a.size());
+  ws.edge_weight.resize(ws.edge_a.size());  // the same hypot values Prim compared
   for (std::size_t e = 0; e < ws.edge_a.size(); ++e) {
     ws.edge_weight[e] = std::hypot(ws.x[ws.edge_a[e]] - ws.x[ws.edge_b[e]],
                                    ws.y[ws.edge_a[e]] - ws.y[ws.edge_b[e]]);
