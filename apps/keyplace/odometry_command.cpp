@@ -425,6 +425,14 @@ void RegisterOdometryCommand(CLI::App& app) {
                    "Gauss-Newton iterations per scan")
       ->capture_default_str();
   command
+      ->add_option("--convergence-translation", options->config.icp.convergence_translation_m,
+                   "ICP stops when an increment moves less than this (m) ...")
+      ->capture_default_str();
+  command
+      ->add_option("--convergence-rotation", options->config.icp.convergence_rotation_rad,
+                   "... and turns less than this (rad)")
+      ->capture_default_str();
+  command
       ->add_option("--max-correction", options->config.max_correction_translation_m,
                    "ICP results further than this from the odometry prediction are rejected "
                    "(m)")

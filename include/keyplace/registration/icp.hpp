@@ -36,7 +36,7 @@ struct IcpConfig {
   // --- robust kernel ---------------------------------------------------------------------
   RobustKernel kernel = RobustKernel::kCauchy;
   // Scale of the kernel on the point-to-line residual (m): Huber threshold, Cauchy c, Tukey c.
-  double kernel_scale_m = 0.05;
+  double kernel_scale_m = 0.1;
 
   // --- target normals --------------------------------------------------------------------
   // Neighbours (including the point itself) used to fit the line through each target point.
@@ -50,8 +50,8 @@ struct IcpConfig {
   // --- iterations ------------------------------------------------------------------------
   int max_iterations = 30;
   // Converged when one Gauss-Newton increment moves less than both of these.
-  double convergence_translation_m = 1e-5;
-  double convergence_rotation_rad = 1e-5;
+  double convergence_translation_m = 1e-4;
+  double convergence_rotation_rad = 1e-4;
 
   // --- degeneracy ------------------------------------------------------------------------
   // Eigen-directions of the (per-correspondence mean) Gauss-Newton information whose eigenvalue
