@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 
@@ -10,9 +12,44 @@ namespace keyplace::features_internal {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Squared distance and hypot each carry < 2 ulp of error; this margin keeps every candidate
-// that might be shorter than the current key (only those get the exact hypot comparison).
-constexpr double kBoundSlack = 1.0 + 1e-13;
+// Squared distances carry a few ulp of error: candidates within this relative margin of the
+// current key are compared exactly.
+constexpr double kGateSlack = 1.0 + kCloseRelative;
+
+// exp(-x) for 0 <= x < 700, within about 1 ulp of std::exp but without libm's call and error
+// handling: exp(-x) = 2^-(m / 128) exp(-r), m = round(128 x / ln 2), with a 128-entry table of
+// 2^-(j / 128) and a degree-5 polynomial on |r| <= ln2 / 256 (truncation error < 1e-18).
+class ExpNegativeTable {
+ public:
+  ExpNegativeTable() {
+    for (int j = 0; j < kSize; ++j) table_[j] = std::exp2(-static_cast<double>(j) / kSize);
+  }
+  double operator()(double x) const {
+    const std::int64_t m = static_cast<std::int64_t>(x * kSizeOverLn2 + 0.5);
+    const double md = static_cast<double>(m);
+    const double r = (x - md * kLn2OverSizeHi) - md * kLn2OverSizeLo;
+    const double p =
+        1.0 - r * (1.0 - r * (0.5 - r * (1.0 / 6.0 - r * (1.0 / 24.0 - r * (1.0 / 120.0)))));
+    // 2^-(m >> 7) assembled in the exponent field (normal range for x < 700).
+    const std::uint64_t bits = static_cast<std::uint64_t>(1023 - (m >> kShift)) << 52;
+    double power;
+    std::memcpy(&power, &bits, sizeof(power));
+    return table_[m & (kSize - 1)] * p * power;
+  }
+
+ private:
+  static constexpr int kShift = 7;
+  static constexpr int kSize = 1 << kShift;
+  static constexpr double kSizeOverLn2 = kSize / 0.693147180559945309417232121458176568;
+  // ln(2) / 128 split into 32 significant bits (m * hi is exact) and the rest.
+  static constexpr double kLn2OverSizeHi = 0x1.62e42feep-8;
+  static constexpr double kLn2OverSizeLo = 0x1.a39ef35793c76p-40;
+  double table_[kSize];
+};
+
+const ExpNegativeTable kExpNegative;
+
+inline double ExpNegative(double x) { return kExpNegative(x); }
 
 // Builds a CSR adjacency from an undirected edge list (both directions).
 void BuildCsr(int n, const std::vector<int>& a, const std::vector<int>& b,
@@ -33,10 +70,13 @@ void BuildCsr(int n, const std::vector<int>& a, const std::vector<int>& b,
 
 // One round of Prim's algorithm from vertex 0 on the complete Euclidean graph minus the edges
 // already taken (and minus the edge (0, n-1)); appends the tree edges to the workspace edge list
-// (as (parent, vertex) in vertex order, like FLIRTLib). Edge weights are hypot(dx, dy) and the
-// visiting order, comparisons and heap follow Boost's prim_minimum_spanning_tree on an adjacency
-// matrix, so that exactly equal edge lengths -- common with centimetre ranges -- are resolved the
-// same way. Dense O(n^2); a squared-distance test skips the hypot of clearly longer edges.
+// as (parent, vertex) in vertex order, like FLIRTLib.
+//
+// FLIRTLib runs Boost's prim_minimum_spanning_tree on an adjacency matrix with hypot(dx, dy)
+// weights. We follow its visiting order, strict comparisons and 4-ary heap, so that exactly
+// equal edge lengths -- common with centimetre ranges on regular structures -- resolve the same
+// way. Keys are kept as squared distances; whenever two of them are too close for their order
+// to be certain, the comparison falls back to the exact hypot values (EdgeLess). Dense O(n^2).
 void PrimRound(int n, CurvatureWorkspace& ws) {
   // Removed edges = the union so far plus (0, n-1).
   ws.edge_a.push_back(0);
@@ -45,58 +85,56 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
   ws.edge_a.pop_back();
   ws.edge_b.pop_back();
 
-  enum : unsigned char { kWhite, kGray, kBlack };
-  ws.prim_color.assign(n, kWhite);
-  ws.prim_key.assign(n, kInf);
-  ws.prim_key_bound.assign(n, kInf);
-  ws.prim_parent.resize(n);
-  ws.prim_removed_mark.assign(n, -1);
-  for (int v = 0; v < n; ++v) ws.prim_parent[v] = v;
-  unsigned char* color = ws.prim_color.data();
-  double* key = ws.prim_key.data();
-  double* key_bound = ws.prim_key_bound.data();
-  int* parent = ws.prim_parent.data();
-  int* removed_mark = ws.prim_removed_mark.data();
   const double* x = ws.x.data();
   const double* y = ws.y.data();
-  QuaternaryHeap& heap = ws.prim_heap;
-  heap.Reset(n, key);
+  ws.prim_key2.assign(n, kInf);
+  ws.prim_gate.assign(n, kInf);  // +inf: white; key2 * slack: gray; -1: black or edge removed
+  ws.prim_parent.resize(n);
+  for (int v = 0; v < n; ++v) ws.prim_parent[v] = v;
+  double* key2 = ws.prim_key2.data();
+  double* gate = ws.prim_gate.data();
+  int* parent = ws.prim_parent.data();
+  const PrimKeyOrder order{x, y, key2, parent};
+  QuaternaryHeap<PrimKeyOrder>& heap = ws.prim_heap;
+  heap.Reset(n, order);
 
-  key[0] = 0.0;
-  color[0] = kGray;
+  key2[0] = 0.0;
+  gate[0] = -1.0;
   heap.Push(0);
   while (!heap.Empty()) {
     const int u = heap.Top();
     heap.Pop();
-    for (int r = ws.removed_offsets[u]; r < ws.removed_offsets[u + 1]; ++r) {
-      removed_mark[ws.removed_targets[r]] = u;
+    gate[u] = -1.0;  // black
+    const int removed_begin = ws.removed_offsets[u];
+    const int removed_end = ws.removed_offsets[u + 1];
+    ws.prim_saved_gate.clear();
+    for (int r = removed_begin; r < removed_end; ++r) {
+      const int t = ws.removed_targets[r];
+      ws.prim_saved_gate.push_back(gate[t]);
+      gate[t] = -1.0;
     }
     const double ux = x[u];
     const double uy = y[u];
     for (int v = 0; v < n; ++v) {
-      if (v == u || removed_mark[v] == u || color[v] == kBlack) continue;
       const double dx = x[v] - ux;
       const double dy = y[v] - uy;
-      if (color[v] == kWhite) {
-        const double weight = std::hypot(dx, dy);
-        if (weight < key[v]) {
-          key[v] = weight;
-          key_bound[v] = weight * weight * kBoundSlack;
-          parent[v] = u;
-        }
-        color[v] = kGray;
+      const double d2 = dx * dx + dy * dy;
+      if (!(d2 <= gate[v])) continue;  // black, removed, or clearly not shorter
+      if (gate[v] == kInf) {           // white: discovered through this edge
+        key2[v] = d2;
+        parent[v] = u;
+        gate[v] = d2 * kGateSlack;
         heap.Push(v);
-      } else if (dx * dx + dy * dy <= key_bound[v]) {
-        const double weight = std::hypot(dx, dy);
-        if (weight < key[v]) {
-          key[v] = weight;
-          key_bound[v] = weight * weight * kBoundSlack;
-          parent[v] = u;
-          heap.DecreaseKey(v);
-        }
+      } else if (EdgeLess(x, y, u, v, d2, parent[v], v, key2[v])) {
+        key2[v] = d2;
+        parent[v] = u;
+        gate[v] = d2 * kGateSlack;
+        heap.DecreaseKey(v);
       }
     }
-    color[u] = kBlack;
+    for (int r = removed_begin; r < removed_end; ++r) {
+      gate[ws.removed_targets[r]] = ws.prim_saved_gate[r - removed_begin];
+    }
   }
   for (int v = 1; v < n; ++v) {
     if (parent[v] == v) continue;  // unreachable (only in tiny point sets)
@@ -105,9 +143,10 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
   }
 }
 
-// Dijkstra from every vertex on the spanning-tree union, truncated at the largest radius. Each
-// row holds the settled vertices in settle order (non-decreasing distance) with their squared
-// distance; row_scale_count[i * L + l] is the length of the prefix within radii[l].
+// Dijkstra from every vertex on the spanning-tree union, truncated at the largest radius. Row i
+// holds the settled vertices j > i (each pair once) in settle order, i.e. by non-decreasing
+// distance, with their squared distance; row_scale_count[i * L + l] is the length of the prefix
+// within radii[l].
 // The graph is nearly a chain, so the frontier stays small (about 5-10 vertices): an unsorted
 // array with a linear minimum search beats a heap here.
 void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWorkspace& ws) {
@@ -151,8 +190,10 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
       frontier_dist[best] = frontier_dist[frontier_size];
       slot[frontier_vertex[best]] = best;
       slot[v] = -1;
-      ws.row_vertex.push_back(v);
-      ws.row_dist2.push_back(d * d);
+      if (v > source) {
+        ws.row_vertex.push_back(v);
+        ws.row_dist2.push_back(d * d);
+      }
       for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
         const int t = adj_targets[e];
         const double nd = d + adj_weights[e];
@@ -218,29 +259,70 @@ void ComputeCurvature(const CurvatureParams& params, CurvatureWorkspace& ws,
   for (int l = 0; l < num_scales; ++l) radii[l] = params.cutoff_sigmas * params.sigmas_m[l];
   TruncatedGeodesicRows(n, radii, ws);
 
-  // 3. Per scale: A(i) = sum_j e_ij / D_j p_j / sum_j e_ij / D_j, D_j = sum_k e_jk.
+  // 3. Per scale: A(i) = sum_j e_ij / D_j p_j / sum_j e_ij / D_j with D_j = sum_k e_jk and
+  // e_ij = exp(-d_ij^2 / (2 sigma^2)), j and k running over the vertices within the cutoff
+  // (including the vertex itself, e_ii = 1). Each pair is stored once and used both ways.
   ws.kernel.resize(ws.row_vertex.size());
+  ws.density.resize(n);
   ws.inv_density.resize(n);
+  ws.sum_w.resize(n);
+  ws.sum_wx.resize(n);
+  ws.sum_wy.resize(n);
   const int* row_offsets = ws.row_offsets.data();
   const int* row_vertex = ws.row_vertex.data();
   const double* row_dist2 = ws.row_dist2.data();
+  const int* row_scale_count = ws.row_scale_count.data();
   double* kernel = ws.kernel.data();
+  double* density = ws.density.data();
   double* inv_density = ws.inv_density.data();
+  double* sum_w = ws.sum_w.data();
+  double* sum_wx = ws.sum_wx.data();
+  double* sum_wy = ws.sum_wy.data();
   const double* x = ws.x.data();
   const double* y = ws.y.data();
   for (int l = 0; l < num_scales; ++l) {
     const double sigma = params.sigmas_m[l];
-    const double neg_inv_two_sigma2 = -1.0 / (2.0 * sigma * sigma);
+    const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+    std::fill(density, density + n, 1.0);
     for (int i = 0; i < n; ++i) {
       const int begin = row_offsets[i];
-      const int end = begin + ws.row_scale_count[static_cast<std::size_t>(i) * num_scales + l];
-      double density = 0.0;
+      const int end = begin + row_scale_count[static_cast<std::size_t>(i) * num_scales + l];
+      double density_i = 0.0;
       for (int k = begin; k < end; ++k) {
-        const double e = std::exp(row_dist2[k] * neg_inv_two_sigma2);
+        const double e = ExpNegative(row_dist2[k] * inv_two_sigma2);
         kernel[k] = e;
-        density += e;
+        density_i += e;
+        density[row_vertex[k]] += e;
       }
-      inv_density[i] = 1.0 / density;
+      density[i] += density_i;
+    }
+    for (int i = 0; i < n; ++i) {
+      inv_density[i] = 1.0 / density[i];
+      sum_w[i] = inv_density[i];
+      sum_wx[i] = inv_density[i] * x[i];
+      sum_wy[i] = inv_density[i] * y[i];
+    }
+    for (int i = 0; i < n; ++i) {
+      const int begin = row_offsets[i];
+      const int end = begin + row_scale_count[static_cast<std::size_t>(i) * num_scales + l];
+      const double xi = x[i];
+      const double yi = y[i];
+      const double inv_density_i = inv_density[i];
+      double w_i = 0.0, wx_i = 0.0, wy_i = 0.0;
+      for (int k = begin; k < end; ++k) {
+        const int j = row_vertex[k];
+        const double w_ij = kernel[k] * inv_density[j];  // weight of p_j in A(i)
+        w_i += w_ij;
+        wx_i += w_ij * x[j];
+        wy_i += w_ij * y[j];
+        const double w_ji = kernel[k] * inv_density_i;  // weight of p_i in A(j)
+        sum_w[j] += w_ji;
+        sum_wx[j] += w_ji * xi;
+        sum_wy[j] += w_ji * yi;
+      }
+      sum_w[i] += w_i;
+      sum_wx[i] += wx_i;
+      sum_wy[i] += wy_i;
     }
     auto& ax = result.ax[l];
     auto& ay = result.ay[l];
@@ -250,19 +332,9 @@ void ComputeCurvature(const CurvatureParams& params, CurvatureWorkspace& ws,
     signal.resize(n);
     const double two_over_sigma = 2.0 * (1.0 / sigma);
     for (int i = 0; i < n; ++i) {
-      const int begin = row_offsets[i];
-      const int end = begin + ws.row_scale_count[static_cast<std::size_t>(i) * num_scales + l];
-      double sw = 0.0, sx = 0.0, sy = 0.0;
-      for (int k = begin; k < end; ++k) {
-        const int j = row_vertex[k];
-        const double w = kernel[k] * inv_density[j];
-        sw += w;
-        sx += w * x[j];
-        sy += w * y[j];
-      }
-      const double inv_sw = 1.0 / sw;
-      ax[i] = sx * inv_sw;
-      ay[i] = sy * inv_sw;
+      const double inv_sum = 1.0 / sum_w[i];
+      ax[i] = sum_wx[i] * inv_sum;
+      ay[i] = sum_wy[i] * inv_sum;
       const double t = two_over_sigma * std::hypot(ax[i] - x[i], ay[i] - y[i]);
       signal[i] = t * std::exp(-t);
     }

@@ -2,19 +2,22 @@
 // Internal: FLIRT's geodesic-graph curvature signal (not installed, not part of the API).
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 
 namespace keyplace::features_internal {
 
-// Indexed 4-ary min-heap on key[], with the sift rules of the Boost Graph Library's
-// d_ary_heap_indirect (which FLIRTLib's Prim runs on), so that equal keys pop in the same order.
+// Indexed 4-ary min-heap of vertices ordered by `Less(a, b)`, with the sift rules of the Boost
+// Graph Library's d_ary_heap_indirect (which FLIRTLib's Prim runs on), so that equal keys pop in
+// the same order.
+template <typename Less>
 class QuaternaryHeap {
  public:
-  void Reset(int n, const double* key) {
+  void Reset(int n, Less less) {
     data_.clear();
     index_.assign(n, -1);
-    key_ = key;
+    less_ = less;
   }
   bool Empty() const { return data_.empty(); }
   int Top() const { return data_[0]; }
@@ -42,11 +45,10 @@ class QuaternaryHeap {
   // Counts the levels the element rises first, then shifts the parents down.
   void SiftUp(int index) {
     const int moving = data_[index];
-    const double moving_key = key_[moving];
     int levels = 0;
     for (int i = index; i > 0;) {
       const int parent = (i - 1) / kArity;
-      if (!(moving_key < key_[data_[parent]])) break;
+      if (!less_(moving, data_[parent])) break;
       ++levels;
       i = parent;
     }
@@ -61,24 +63,20 @@ class QuaternaryHeap {
     index_[moving] = i;
   }
 
-  // Swaps the root down with its smallest child (first one on equal keys) while smaller.
+  // Swaps the root down with its smallest child (the first one among equals) while smaller.
   void SiftDown() {
     const int size = static_cast<int>(data_.size());
-    const double moving_key = key_[data_[0]];
+    const int moving = data_[0];
     int index = 0;
     for (;;) {
       const int first_child = index * kArity + 1;
       if (first_child >= size) break;
       const int last_child = std::min(first_child + kArity, size);
       int smallest = first_child;
-      double smallest_key = key_[data_[first_child]];
       for (int c = first_child + 1; c < last_child; ++c) {
-        if (key_[data_[c]] < smallest_key) {
-          smallest = c;
-          smallest_key = key_[data_[c]];
-        }
+        if (less_(data_[c], data_[smallest])) smallest = c;
       }
-      if (!(smallest_key < moving_key)) break;
+      if (!less_(data_[smallest], moving)) break;
       std::swap(data_[smallest], data_[index]);
       index_[data_[smallest]] = smallest;
       index_[data_[index]] = index;
@@ -88,7 +86,30 @@ class QuaternaryHeap {
 
   std::vector<int> data_;
   std::vector<int> index_;
-  const double* key_ = nullptr;
+  Less less_{};
+};
+
+// Squared distances carry a few ulp of error; when two are closer than this (relative), their
+// order is decided by the exact hypot values that FLIRTLib compares.
+constexpr double kCloseRelative = 1e-12;
+
+/// hypot(edge a1-b1) < hypot(edge a2-b2), given the squared lengths of both edges.
+inline bool EdgeLess(const double* x, const double* y, int a1, int b1, double d2_1, int a2, int b2,
+                     double d2_2) {
+  if (d2_1 < d2_2 * (1.0 - kCloseRelative)) return true;
+  if (d2_1 > d2_2 * (1.0 + kCloseRelative)) return false;
+  return std::hypot(x[a1] - x[b1], y[a1] - y[b1]) < std::hypot(x[a2] - x[b2], y[a2] - y[b2]);
+}
+
+/// Orders Prim's vertices by their key edge (parent[v], v).
+struct PrimKeyOrder {
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* key2 = nullptr;
+  const int* parent = nullptr;
+  bool operator()(int a, int b) const {
+    return EdgeLess(x, y, parent[a], a, key2[a], parent[b], b, key2[b]);
+  }
 };
 
 /// Scratch buffers of the detector, reused between scans (one per thread).
@@ -96,10 +117,9 @@ struct CurvatureWorkspace {
   // Vertex positions (valid beams in scan order).
   std::vector<double> x, y;
   // Prim.
-  std::vector<unsigned char> prim_color;
-  std::vector<int> prim_parent, prim_removed_mark;
-  std::vector<double> prim_key, prim_key_bound;
-  QuaternaryHeap prim_heap;
+  std::vector<int> prim_parent;
+  std::vector<double> prim_key2, prim_gate, prim_saved_gate;
+  QuaternaryHeap<PrimKeyOrder> prim_heap;
   // Edges of the spanning-tree union (and its CSR adjacency).
   std::vector<int> edge_a, edge_b;
   std::vector<double> edge_weight;
@@ -112,7 +132,7 @@ struct CurvatureWorkspace {
   std::vector<double> dijkstra_dist, frontier_dist;
   std::vector<int> dijkstra_stamp, dijkstra_slot, frontier_vertex;
   // Smoothing.
-  std::vector<double> kernel, inv_density;
+  std::vector<double> kernel, density, inv_density, sum_w, sum_wx, sum_wy;
 };
 
 struct CurvatureParams {
