@@ -9,5 +9,6 @@ namespace keyplace::cli {
 void RegisterInfoCommand(CLI::App& app);
 void RegisterFeaturesCommand(CLI::App& app);
 void RegisterOdometryCommand(CLI::App& app);
+void RegisterMapCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "keyplace 0.1.0");
   app.require_subcommand(1);
   keyplace::cli::RegisterInfoCommand(app);
+  keyplace::cli::RegisterFeaturesCommand(app);
   keyplace::cli::RegisterOdometryCommand(app);
+  keyplace::cli::RegisterMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

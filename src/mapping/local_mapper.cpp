@@ -53,7 +53,7 @@ void LocalMapper::Reset() {
   scan_indices_.clear();
   poses_.clear();
   stable_.clear();
-  laser_cells_.clear();
+  hit_cells_.clear();
   initial_cells_ = 0;
   overlap_ = 1.0;
   distribution_ = 1.0;
@@ -75,9 +75,8 @@ bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_
     if (scan.valid[i] != 0) endpoints_m.push_back(T_submap_laser * scan.Endpoint(i));
   }
   grid_.InsertRays(T_submap_laser.translation(), endpoints_m, static_cast<int>(poses_.size()) - 1);
-  for (const auto& cell : grid_.newly_hit_cells()) {
-    laser_cells_.insert(DistributionKey(grid_.CellCenter(cell), config_.distribution_cell_m));
-  }
+  hit_cells_.insert(hit_cells_.end(), grid_.newly_hit_cells().begin(),
+                    grid_.newly_hit_cells().end());
   for (const Keypoint& keypoint : keypoints) {
     GridKeypoint grid_keypoint;
     grid_keypoint.position_m = T_submap_laser * keypoint.position_m;
@@ -111,7 +110,16 @@ void LocalMapper::UpdateCompletion() {
     keypoint_cells.insert(
         DistributionKey(selected.keypoint.position_m, config_.distribution_cell_m));
   }
-  distribution_ = DistributionFromCells(laser_cells_, keypoint_cells);
+  std::unordered_set<std::int64_t> laser_cells;
+  using LaserCells = MappingConfig::LaserCells;
+  const LaserCells which = config_.distribution_laser_cells;
+  for (const auto& cell : hit_cells_) {
+    const CellCounts counts = grid_.Counts(cell);
+    if (which != LaserCells::kHit && 2 * counts.hits <= counts.hits + counts.misses) continue;
+    if (which == LaserCells::kPersistent && counts.scans_hit < config_.min_scan_count) continue;
+    laser_cells.insert(DistributionKey(grid_.CellCenter(cell), config_.distribution_cell_m));
+  }
+  distribution_ = DistributionFromCells(laser_cells, keypoint_cells);
   complete_ = overlap_ < config_.min_overlap &&
               (!config_.use_distribution || distribution_ <= config_.max_distribution) &&
               static_cast<int>(stable_.size()) >= config_.min_stable_keypoints;

@@ -73,6 +73,8 @@ std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig
       {"min_stability", FormatDouble(c.min_stability)},
       {"min_scan_count", std::to_string(c.min_scan_count)},
       {"descriptor_match_chi2", FormatDouble(c.descriptor_match_chi2)},
+      {"density_counting",
+       c.density_counting == MappingConfig::DensityCounting::kScans ? "scans" : "beams"},
       {"cluster_match",
        c.cluster_match == ClusterMatch::kAnyMember ? "any_member" : "latest_member"},
       {"min_overlap", FormatDouble(c.min_overlap)},
@@ -80,6 +82,10 @@ std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig
       {"use_distribution", c.use_distribution ? "true" : "false"},
       {"max_distribution", FormatDouble(c.max_distribution)},
       {"distribution_cell_m", FormatDouble(c.distribution_cell_m)},
+      {"distribution_laser_cells",
+       c.distribution_laser_cells == MappingConfig::LaserCells::kHit        ? "hit"
+       : c.distribution_laser_cells == MappingConfig::LaserCells::kOccupied ? "occupied"
+                                                                            : "persistent"},
       {"min_stable_keypoints", std::to_string(c.min_stable_keypoints)},
       {"max_scans_per_submap", std::to_string(c.max_scans_per_submap)},
   };
@@ -95,6 +101,15 @@ void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingCon
       c.min_scan_count = ParseInt(key, text);
     } else if (key == "descriptor_match_chi2") {
       c.descriptor_match_chi2 = ParseDouble(key, text);
+    } else if (key == "density_counting") {
+      if (text == "scans") {
+        c.density_counting = MappingConfig::DensityCounting::kScans;
+      } else if (text == "beams") {
+        c.density_counting = MappingConfig::DensityCounting::kBeams;
+      } else {
+        throw std::invalid_argument("MappingConfig.density_counting: '" + text +
+                                    "' is not scans or beams");
+      }
     } else if (key == "cluster_match") {
       if (text == "any_member") {
         c.cluster_match = MappingConfig::ClusterMatch::kAnyMember;
@@ -121,6 +136,17 @@ void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingCon
       c.max_distribution = ParseDouble(key, text);
     } else if (key == "distribution_cell_m") {
       c.distribution_cell_m = ParseDouble(key, text);
+    } else if (key == "distribution_laser_cells") {
+      if (text == "hit") {
+        c.distribution_laser_cells = MappingConfig::LaserCells::kHit;
+      } else if (text == "occupied") {
+        c.distribution_laser_cells = MappingConfig::LaserCells::kOccupied;
+      } else if (text == "persistent") {
+        c.distribution_laser_cells = MappingConfig::LaserCells::kPersistent;
+      } else {
+        throw std::invalid_argument("MappingConfig.distribution_laser_cells: '" + text +
+                                    "' is not hit, occupied or persistent");
+      }
     } else if (key == "min_stable_keypoints") {
       c.min_stable_keypoints = ParseInt(key, text);
     } else if (key == "max_scans_per_submap") {

@@ -76,8 +76,14 @@ void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
   height_ = new_height;
 }
 
-void StabilityGrid::AddMiss(int i, int j) {
+void StabilityGrid::AddMiss(int i, int j, int scan_id) {
   CellCounts& cell = At(i, j);
+  if (config_.density_counting == MappingConfig::DensityCounting::kScans) {
+    // Once per scan, and not at all when this scan also ends a beam in the cell (the hits of a
+    // scan are all cast before its misses).
+    if (cell.last_scan == scan_id || cell.last_miss_scan == scan_id) return;
+    cell.last_miss_scan = scan_id;
+  }
   if (cell.hits == 0 && cell.misses == 0) ++observed_cells_;
   ++cell.misses;
 }
@@ -89,10 +95,12 @@ void StabilityGrid::AddHit(int i, int j, int scan_id) {
     newly_hit_cells_.push_back({i, j});
     if (cell.misses == 0) ++observed_cells_;
   }
-  ++cell.hits;
   if (cell.last_scan != scan_id) {
     cell.last_scan = scan_id;
     ++cell.scans_hit;
+    ++cell.hits;
+  } else if (config_.density_counting == MappingConfig::DensityCounting::kBeams) {
+    ++cell.hits;
   }
 }
 
@@ -111,10 +119,18 @@ void StabilityGrid::InsertRays(const Eigen::Vector2d& origin_m,
   }
   EnsureCovers(min_i, min_j, max_i, max_j);
 
-  const double inf = std::numeric_limits<double>::infinity();
+  // All hits first, so that per-scan counting knows which cells this scan hits.
+  std::vector<CellIndex> ends;
+  ends.reserve(endpoints_m.size());
   for (const auto& endpoint : endpoints_m) {
+    ends.push_back(CellOf(endpoint));
+    AddHit(ends.back().i, ends.back().j, scan_id);
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < endpoints_m.size(); ++k) {
     // Amanatides-Woo traversal of the cells between the origin and the endpoint.
-    const CellIndex end = CellOf(endpoint);
+    const Eigen::Vector2d& endpoint = endpoints_m[k];
+    const CellIndex end = ends[k];
     int i = start.i;
     int j = start.j;
     const double dx = endpoint.x() - origin_m.x();
@@ -130,7 +146,7 @@ void StabilityGrid::InsertRays(const Eigen::Vector2d& origin_m,
     // Rounding can miss the end cell by one step; never walk further than the Manhattan distance.
     int steps_left = std::abs(end.i - i) + std::abs(end.j - j);
     while ((i != end.i || j != end.j) && steps_left-- > 0) {
-      AddMiss(i, j);
+      AddMiss(i, j, scan_id);
       if (t_max_x < t_max_y) {
         t_max_x += t_delta_x;
         i += step_i;
@@ -139,7 +155,6 @@ void StabilityGrid::InsertRays(const Eigen::Vector2d& origin_m,
         j += step_j;
       }
     }
-    AddHit(end.i, end.j, scan_id);
   }
 }
 

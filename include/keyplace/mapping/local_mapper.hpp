@@ -51,7 +51,7 @@ class LocalMapper {
   std::vector<int> scan_indices_;
   std::vector<Pose2> poses_;
   std::vector<StabilityGrid::Selected> stable_;
-  std::unordered_set<std::int64_t> laser_cells_;  // cells of D holding a hit cell of G
+  std::vector<CellIndex> hit_cells_;  // cells of G hit so far, in order of their first hit
   std::int64_t initial_cells_ = 0;
   double overlap_ = 1.0;
   double distribution_ = 1.0;

@@ -9,6 +9,11 @@ struct MappingConfig {
   double min_stability = 0.3;          // s_min: a cell's keypoint is stable when s >= s_min
   int min_scan_count = 4;              // ns_min: s = d * occ / max(ns, ns_min)
   double descriptor_match_chi2 = 0.4;  // similar descriptors: symmetric chi2 below this
+  // How h and m of the density d = h / (h + m) are counted. kScans: once per scan, h when one of
+  // its beams ends in the cell, m when its beams only cross it (a wall cell grazed by the beams
+  // to the next wall points of the same scan stays occupied). kBeams: once per beam.
+  enum class DensityCounting { kScans, kBeams };
+  DensityCounting density_counting = DensityCounting::kScans;
 
   // Which member of a history cluster a new keypoint is compared with. The paper says "look for a
   // match with keypoints in every history cluster": kAnyMember joins the first (largest) cluster
@@ -22,11 +27,17 @@ struct MappingConfig {
   // Cells that make the binary occupancy grids of rho: kHit = cells some beam ended in (the
   // occupied cells), kObserved = cells some beam ended in or crossed (the seen area).
   enum class OverlapCells { kHit, kObserved };
-  OverlapCells overlap_cells = OverlapCells::kHit;
+  OverlapCells overlap_cells = OverlapCells::kObserved;
   bool use_distribution = true;      // also require delta <= max_distribution (Section 5.2)
   double max_distribution = 0.5;     // delta_max
   double distribution_cell_m = 0.5;  // l: cell of the grid D of the histograms of delta
-  int min_stable_keypoints = 10;     // and at least this many stable keypoints (Section 5.2)
+  // Which cells of G are the "laser points" of h_lp: kHit = every cell a beam ended in;
+  // kOccupied = cells of the occupancy grid, d = h / (h + m) > 0.5; kPersistent = occupied cells
+  // hit by at least ns_min scans (the cells whose keypoints could reach s_min). See
+  // docs/MAPPING.md for why the default is kPersistent.
+  enum class LaserCells { kHit, kOccupied, kPersistent };
+  LaserCells distribution_laser_cells = LaserCells::kPersistent;
+  int min_stable_keypoints = 10;  // and at least this many stable keypoints (Section 5.2)
   // Safety net absent from the paper: a submap that has not met the criteria after this many
   // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
   // submap that cannot be completed, as in the paper).

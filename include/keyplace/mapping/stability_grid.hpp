@@ -23,10 +23,11 @@ struct CellIndex {
 };
 
 struct CellCounts {
-  std::int32_t hits = 0;        // h: beams that ended in the cell
-  std::int32_t misses = 0;      // m: beams that crossed the cell without ending in it
-  std::int32_t scans_hit = 0;   // ns: scans with at least one hit in the cell
-  std::int32_t last_scan = -1;  // scan id of the latest hit (to count ns once per scan)
+  std::int32_t hits = 0;             // h: beams that ended in the cell
+  std::int32_t misses = 0;           // m: beams that crossed the cell without ending in it
+  std::int32_t scans_hit = 0;        // ns: scans with at least one hit in the cell
+  std::int32_t last_scan = -1;       // scan id of the latest hit (to count ns once per scan)
+  std::int32_t last_miss_scan = -1;  // scan id of the latest miss (per-scan counting)
 };
 
 /// A keypoint of some scan, expressed in the submap frame.
@@ -46,7 +47,8 @@ class StabilityGrid {
   void Clear();
 
   /// UpdateG's counters: ray-casts each endpoint from `origin_m` (both in the submap frame). The
-  /// endpoint's cell gets a hit, every other cell the ray crosses a miss. `scan_id` must grow.
+  /// endpoint's cell gets a hit, every other cell the ray crosses a miss (counted per beam or
+  /// once per scan, MappingConfig::density_counting). `scan_id` must grow.
   void InsertRays(const Eigen::Vector2d& origin_m, const std::vector<Eigen::Vector2d>& endpoints_m,
                   int scan_id);
 
@@ -97,7 +99,7 @@ class StabilityGrid {
 
   void EnsureCovers(int min_i, int min_j, int max_i, int max_j);
   CellCounts& At(int i, int j) { return counts_[(j - origin_j_) * width_ + (i - origin_i_)]; }
-  void AddMiss(int i, int j);
+  void AddMiss(int i, int j, int scan_id);
   void AddHit(int i, int j, int scan_id);
   static std::int64_t Key(const CellIndex& cell) {
     return (static_cast<std::int64_t>(cell.i) << 32) ^ static_cast<std::uint32_t>(cell.j);

@@ -1,0 +1,206 @@
+#include "map_figure.hpp"
+
+#include <cairo-svg.h>
+#include <cairo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace keyplace::cli {
+namespace {
+
+struct Bounds {
+  double min_x = std::numeric_limits<double>::max();
+  double min_y = std::numeric_limits<double>::max();
+  double max_x = std::numeric_limits<double>::lowest();
+  double max_y = std::numeric_limits<double>::lowest();
+  void Add(const Eigen::Vector2d& p) {
+    min_x = std::min(min_x, p.x());
+    min_y = std::min(min_y, p.y());
+    max_x = std::max(max_x, p.x());
+    max_y = std::max(max_y, p.y());
+  }
+  bool empty() const { return min_x > max_x; }
+};
+
+bool EndsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() &&
+         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// A colour per submap that neighbours can tell apart (golden-angle hue steps).
+void SubmapColour(cairo_t* cr, int id) {
+  const double hue = std::fmod(id * 137.508, 360.0) / 60.0;
+  const double x = 1.0 - std::abs(std::fmod(hue, 2.0) - 1.0);
+  double r = 0, g = 0, b = 0;
+  switch (static_cast<int>(hue)) {
+    case 0:
+      r = 1, g = x;
+      break;
+    case 1:
+      r = x, g = 1;
+      break;
+    case 2:
+      g = 1, b = x;
+      break;
+    case 3:
+      g = x, b = 1;
+      break;
+    case 4:
+      r = x, b = 1;
+      break;
+    default:
+      r = 1, b = x;
+      break;
+  }
+  cairo_set_source_rgb(cr, 0.85 * r, 0.85 * g, 0.85 * b);
+}
+
+}  // namespace
+
+void DrawMapFigure(const std::string& path, const GlobalMap& map,
+                   const std::vector<LaserScan>& scans, const std::vector<Pose2>& poses,
+                   const MapFigureOptions& options) {
+  const bool svg = EndsWith(path, ".svg");
+  if (!svg && !EndsWith(path, ".png")) {
+    throw std::invalid_argument(path + ": figure file name must end in .png or .svg");
+  }
+  // World points of the scans that went into submaps (every other beam is plenty to look at).
+  std::vector<Eigen::Vector2d> points;
+  Bounds bounds;
+  for (const Submap& submap : map.submaps) {
+    for (const int index : submap.scan_indices) {
+      if (index < 0 || static_cast<std::size_t>(index) >= scans.size() ||
+          static_cast<std::size_t>(index) >= poses.size()) {
+        continue;
+      }
+      const LaserScan& scan = scans[index];
+      const Pose2 T_world_laser = poses[index] * scan.T_robot_laser;
+      for (std::size_t b = 0; b < scan.size(); b += 2) {
+        if (scan.valid[b] == 0 || scan.ranges_m[b] > 30.0) continue;
+        points.push_back(T_world_laser * scan.Endpoint(b));
+        bounds.Add(points.back());
+      }
+    }
+  }
+  for (const Submap& submap : map.submaps) {
+    bounds.Add(submap.origin().translation());
+    for (const auto& keypoint : submap.keypoints) bounds.Add(submap.origin() * keypoint.position_m);
+  }
+  if (bounds.empty()) bounds.Add({0, 0});
+  const double margin_m = 1.0;
+  const double width_m = bounds.max_x - bounds.min_x + 2 * margin_m;
+  const double height_m = bounds.max_y - bounds.min_y + 2 * margin_m;
+  const double scale =
+      std::min(options.pixels_per_m, options.max_side_px / std::max(width_m, height_m));
+  const int header_px = 36;
+  const int width_px = static_cast<int>(std::ceil(width_m * scale));
+  const int height_px = static_cast<int>(std::ceil(height_m * scale)) + header_px;
+
+  const std::filesystem::path target(path);
+  const std::string temporary =
+      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
+  cairo_surface_t* surface =
+      svg ? cairo_svg_surface_create(temporary.c_str(), width_px, height_px)
+          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px);
+  cairo_t* cr = cairo_create(surface);
+  const auto to_px = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d((p.x() - bounds.min_x + margin_m) * scale,
+                           header_px + (bounds.max_y + margin_m - p.y()) * scale);
+  };
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+
+  // Scan points, light.
+  cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.35);
+  const double dot = std::max(0.6, 0.03 * scale);
+  for (const auto& point : points) {
+    const Eigen::Vector2d p = to_px(point);
+    cairo_rectangle(cr, p.x() - dot / 2, p.y() - dot / 2, dot, dot);
+  }
+  cairo_fill(cr);
+
+  // Trajectory through the submap origins.
+  cairo_set_source_rgba(cr, 0.1, 0.1, 0.1, 0.6);
+  cairo_set_line_width(cr, 1.0);
+  for (std::size_t s = 0; s < map.submaps.size(); ++s) {
+    const Eigen::Vector2d p = to_px(map.submaps[s].origin().translation());
+    if (s == 0) {
+      cairo_move_to(cr, p.x(), p.y());
+    } else {
+      cairo_line_to(cr, p.x(), p.y());
+    }
+  }
+  cairo_stroke(cr);
+
+  // Stable keypoints, coloured by submap.
+  const double radius = std::max(1.5, 0.06 * scale);
+  for (const Submap& submap : map.submaps) {
+    SubmapColour(cr, submap.id);
+    for (const auto& keypoint : submap.keypoints) {
+      const Eigen::Vector2d p = to_px(submap.origin() * keypoint.position_m);
+      cairo_new_sub_path(cr);
+      cairo_arc(cr, p.x(), p.y(), radius, 0, 2 * M_PI);
+    }
+    cairo_fill(cr);
+  }
+
+  // Submap origins: small black triangles pointing along the robot heading.
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  const double size = std::max(3.0, 0.15 * scale);
+  for (const Submap& submap : map.submaps) {
+    const Pose2& origin = submap.origin();
+    const Eigen::Vector2d tip = to_px(origin * Eigen::Vector2d(size / scale, 0));
+    const Eigen::Vector2d left = to_px(origin * Eigen::Vector2d(-size / scale, 0.6 * size / scale));
+    const Eigen::Vector2d right =
+        to_px(origin * Eigen::Vector2d(-size / scale, -0.6 * size / scale));
+    cairo_move_to(cr, tip.x(), tip.y());
+    cairo_line_to(cr, left.x(), left.y());
+    cairo_line_to(cr, right.x(), right.y());
+    cairo_close_path(cr);
+  }
+  cairo_fill(cr);
+
+  // Header: title and a 5 m scale bar.
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, 14);
+  cairo_move_to(cr, 8, 22);
+  const std::string title =
+      options.title.empty()
+          ? fmt::format("{} submaps, {} stable keypoints", map.submaps.size(), map.KeypointCount())
+          : options.title;
+  cairo_show_text(cr, title.c_str());
+  const double bar_px = 5.0 * scale;
+  cairo_set_line_width(cr, 2.0);
+  cairo_move_to(cr, width_px - bar_px - 10, 24);
+  cairo_line_to(cr, width_px - 10, 24);
+  cairo_stroke(cr);
+  cairo_move_to(cr, width_px - bar_px - 10, 16);
+  cairo_show_text(cr, "5 m");
+
+  cairo_destroy(cr);
+  cairo_status_t status = CAIRO_STATUS_SUCCESS;
+  if (svg) {
+    cairo_surface_finish(surface);
+    status = cairo_surface_status(surface);
+  } else {
+    status = cairo_surface_write_to_png(surface, temporary.c_str());
+  }
+  cairo_surface_destroy(surface);
+  std::error_code error;
+  if (status != CAIRO_STATUS_SUCCESS) {
+    std::filesystem::remove(temporary, error);
+    throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
+  }
+  std::filesystem::rename(temporary, target, error);
+  if (error) throw std::runtime_error(path + ": cannot rename figure: " + error.message());
+}
+
+}  // namespace keyplace::cli
