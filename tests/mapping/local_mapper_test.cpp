@@ -45,10 +45,17 @@ TEST(DistributionDistance, HandComputedCases) {
   EXPECT_NEAR(DistributionDistance(laser, {}, 0.5), 1.0, 1e-12);
 }
 
-TEST(LocalMapper, OverlapFallsAsTheRobotMovesAndCompletesBelowRhoMin) {
+class OverlapTest : public ::testing::TestWithParam<MappingConfig::OverlapCells> {};
+
+TEST_P(OverlapTest, OverlapFallsAsTheRobotMovesAndCompletesBelowRhoMin) {
   MappingConfig config;
   config.use_distribution = false;
   config.min_stable_keypoints = 0;
+  config.overlap_cells = GetParam();
+  const auto cells = [&](const LocalMapper& m) {
+    return GetParam() == MappingConfig::OverlapCells::kHit ? m.grid().hit_cell_count()
+                                                           : m.grid().observed_cell_count();
+  };
   LocalMapper mapper(config);
   double previous_overlap = 1.0;
   int completed_at = -1;
@@ -60,10 +67,9 @@ TEST(LocalMapper, OverlapFallsAsTheRobotMovesAndCompletesBelowRhoMin) {
     const bool complete = mapper.AddScan(k, scan, pose, {});
     EXPECT_LE(mapper.overlap(), previous_overlap + 1e-12);
     previous_overlap = mapper.overlap();
-    // rho = a_int / a_uni with the first scan's hit cells inside the current ones.
-    if (k == 0) initial_cells = mapper.grid().hit_cell_count();
-    const double expected =
-        static_cast<double>(initial_cells) / static_cast<double>(mapper.grid().hit_cell_count());
+    // rho = a_int / a_uni with the first scan's cells inside the current ones.
+    if (k == 0) initial_cells = cells(mapper);
+    const double expected = static_cast<double>(initial_cells) / static_cast<double>(cells(mapper));
     EXPECT_DOUBLE_EQ(mapper.overlap(), expected);
     EXPECT_EQ(complete, expected < config.min_overlap) << k;
     if (complete) completed_at = k;
@@ -77,6 +83,10 @@ TEST(LocalMapper, OverlapFallsAsTheRobotMovesAndCompletesBelowRhoMin) {
   EXPECT_EQ(static_cast<std::int64_t>(submap.occupancy.cells.size()),
             mapper.grid().hit_cell_count());
 }
+
+INSTANTIATE_TEST_SUITE_P(BothOverlapReadings, OverlapTest,
+                         ::testing::Values(MappingConfig::OverlapCells::kHit,
+                                           MappingConfig::OverlapCells::kObserved));
 
 TEST(LocalMapper, StaticRobotNeverCompletesUntilForced) {
   MappingConfig config;

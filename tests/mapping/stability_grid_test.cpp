@@ -7,9 +7,11 @@
 namespace keyplace {
 namespace {
 
-MappingConfig UnitCells() {
+MappingConfig UnitCells(
+    MappingConfig::DensityCounting counting = MappingConfig::DensityCounting::kBeams) {
   MappingConfig config;
   config.cell_size_m = 1.0;  // easy hand computation
+  config.density_counting = counting;
   return config;
 }
 
@@ -76,6 +78,21 @@ TEST(StabilityGrid, ScansHitCountsEachScanOnce) {
   EXPECT_EQ(grid.Counts({0, 0}).misses, 3);  // two beams of scan 0, one of scan 1
 }
 
+TEST(StabilityGrid, PerScanCountingCountsEachCellOncePerScan) {
+  StabilityGrid grid(UnitCells(MappingConfig::DensityCounting::kScans));
+  grid.InsertRays({0.5, 0.5}, {{3.2, 0.5}, {3.8, 0.7}, {5.5, 0.5}}, 0);
+  // Two beams end in (3, 0) and a third crosses it: one hit, no miss for this scan.
+  EXPECT_EQ(grid.Counts({3, 0}).hits, 1);
+  EXPECT_EQ(grid.Counts({3, 0}).misses, 0);
+  EXPECT_EQ(grid.Counts({0, 0}).misses, 1);  // crossed by three beams of one scan
+  grid.InsertRays({0.5, 0.5}, {{5.5, 0.5}}, 1);
+  EXPECT_EQ(grid.Counts({3, 0}).hits, 1);
+  EXPECT_EQ(grid.Counts({3, 0}).misses, 1);  // scan 1 only crosses it
+  EXPECT_EQ(grid.Counts({5, 0}).hits, 2);
+  EXPECT_EQ(grid.Counts({5, 0}).scans_hit, 2);
+  EXPECT_EQ(grid.Counts({0, 0}).misses, 2);
+}
+
 TEST(StabilityGrid, ClustersGroupSimilarDescriptorsLargestFirst) {
   StabilityGrid grid(UnitCells());
   ASSERT_GT(SymmetricChi2(Uniform(), Peaked()), 0.4);
@@ -117,6 +134,17 @@ TEST(StabilityGrid, StabilityAndSelectionMatchHandComputation) {
   EXPECT_EQ(selected[0].keypoint.scan_index, 2);  // most recent of the largest cluster
   EXPECT_EQ(selected[0].occurrences, 2);
   EXPECT_DOUBLE_EQ(selected[0].stability, 0.375);
+}
+
+TEST(StabilityGrid, PerScanDensityIgnoresMissesFromTheScanThatHits) {
+  StabilityGrid grid(UnitCells(MappingConfig::DensityCounting::kScans));
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}}, 0);
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}}, 1);
+  grid.InsertRays({0.5, 0.5}, {{3.5, 0.5}, {5.5, 0.5}}, 2);
+  grid.InsertKeypoint(At(3.5, 0.5, 0, Peaked()));
+  grid.InsertKeypoint(At(3.5, 0.5, 2, Peaked(0.01f)));
+  // h = 3 (one per scan), m = 0: d = 1, occ = 2, ns = max(3, 4): s = 0.5.
+  EXPECT_DOUBLE_EQ(grid.Stability({3, 0}), 0.5);
 }
 
 TEST(StabilityGrid, LatestMemberMatchingComparesOnlyTheNewestKeypoint) {
