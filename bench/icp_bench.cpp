@@ -4,7 +4,8 @@
 //    off by 5 cm / 2 deg; target prepared once, only AlignPointToLine is timed.
 //  - BM_BuildTarget/<beams>: kd-tree + normals for one scan.
 //  - BM_AlignLocalMap/<log>: real scans of intel-raw (180 beams) / fr079-raw (360 beams) against
-//    a local map of the 10 previous scans (as ScanOdometry does), guess = odometry increment.
+//    a local map of the 10 previous scans (as ScanOdometry does), guess = odometry increment;
+//    the source is subsampled like ScanOdometry does (source_min_spacing_m).
 //    Needs ../shared/data; skipped with a message when absent.
 //  - BM_ScanOdometry/<log>: the whole per-scan step (filter, ICP, key-scan map update).
 
@@ -140,7 +141,8 @@ const std::vector<Problem>* Problems(const std::string& name) {
   std::vector<Problem> problems;
   for (std::size_t i = kFirst; i < end; ++i) {
     Problem problem;
-    problem.source = points[i];
+    problem.source =
+        keyplace::ScanOdometry::SubsampleBySpacing(points[i], config.source_min_spacing_m);
     for (std::size_t j = i - kMapScans; j < i; ++j) {
       for (const auto& p : points[j]) problem.map.push_back(T_world_laser[j] * p);
     }

@@ -86,6 +86,7 @@ nlohmann::json ConfigJson(const ScanOdometryConfig& c) {
   const IcpConfig& i = c.icp;
   return {{"min_range_m", c.min_range_m},
           {"max_range_m", c.max_range_m},
+          {"source_min_spacing_m", c.source_min_spacing_m},
           {"local_map_scans", c.local_map_scans},
           {"keyframe_translation_m", c.keyframe_translation_m},
           {"keyframe_rotation_rad", c.keyframe_rotation_rad},
@@ -390,6 +391,10 @@ void RegisterOdometryCommand(CLI::App& app) {
   command
       ->add_option("--keyframe-rotation", options->config.keyframe_rotation_rad,
                    "... or turning this much (rad)")
+      ->capture_default_str();
+  command
+      ->add_option("--source-spacing", options->config.source_min_spacing_m,
+                   "registered scan: skip points closer than this to the previous kept one (m)")
       ->capture_default_str();
   command->add_option("--min-range", options->config.min_range_m, "shortest beam used (m)")
       ->capture_default_str();

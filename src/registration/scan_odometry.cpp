@@ -42,6 +42,7 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
   }
   Require(c.min_range_m >= 0.0, "min_range_m", "must be >= 0");
   Require(c.max_range_m > c.min_range_m, "max_range_m", "must be > min_range_m");
+  Require(c.source_min_spacing_m >= 0.0, "source_min_spacing_m", "must be >= 0");
   Require(c.local_map_scans >= 1, "local_map_scans", "must be >= 1");
   Require(c.keyframe_translation_m >= 0.0, "keyframe_translation_m", "must be >= 0");
   Require(c.keyframe_rotation_rad >= 0.0, "keyframe_rotation_rad", "must be >= 0");
@@ -68,6 +69,18 @@ std::vector<Eigen::Vector2d> ScanOdometry::FilteredEndpoints(const LaserScan& sc
     points.emplace_back(r * std::cos(a), r * std::sin(a));
   }
   return points;
+}
+
+std::vector<Eigen::Vector2d> ScanOdometry::SubsampleBySpacing(
+    const std::vector<Eigen::Vector2d>& points, double spacing_m) {
+  if (spacing_m <= 0.0 || points.empty()) return points;
+  std::vector<Eigen::Vector2d> kept;
+  kept.reserve(points.size());
+  const double spacing2 = spacing_m * spacing_m;
+  for (const Eigen::Vector2d& p : points) {
+    if (kept.empty() || (p - kept.back()).squaredNorm() >= spacing2) kept.push_back(p);
+  }
+  return kept;
 }
 
 void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
@@ -134,7 +147,8 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan) {
       result.icp_status = IcpStatus::kTooFewPoints;
     } else {
       const IcpResult icp =
-          AlignPointToLine(*target_, points, predicted_T_world_laser, config_.icp);
+          AlignPointToLine(*target_, SubsampleBySpacing(points, config_.source_min_spacing_m),
+                           predicted_T_world_laser, config_.icp);
       result.icp_status = icp.status;
       result.iterations = icp.iterations;
       result.inlier_ratio = icp.inlier_ratio;

@@ -25,6 +25,11 @@ struct ScanOdometryConfig {
   double min_range_m = 0.1;
   double max_range_m = 30.0;
 
+  // Source points (the scan being registered) closer than this to the previously kept point,
+  // in beam order, are skipped (m). Dense short-range beams then cost less ICP time; the map
+  // keeps every point. 0 keeps all.
+  double source_min_spacing_m = 0.03;
+
   // The local map holds the last `local_map_scans` key scans (their endpoints in the world
   // frame). A scan becomes a key scan when its registered laser pose has moved at least
   // keyframe_translation_m or turned keyframe_rotation_rad since the last key scan; a stationary
@@ -90,6 +95,9 @@ class ScanOdometry {
   /// Endpoints of the scan's usable beams (range filter of the config), in the laser frame.
   static std::vector<Eigen::Vector2d> FilteredEndpoints(const LaserScan& scan,
                                                         const ScanOdometryConfig& config);
+  /// Keeps a point when it is at least spacing_m from the last kept one (in order).
+  static std::vector<Eigen::Vector2d> SubsampleBySpacing(const std::vector<Eigen::Vector2d>& points,
+                                                         double spacing_m);
 
  private:
   void AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser, const Pose2& T_world_laser);
