@@ -160,3 +160,21 @@ TEST(ScanOdometryTest, InvalidConfigThrowsNamingTheField) {
 
 }  // namespace
 }  // namespace keyplace
+
+namespace keyplace {
+namespace {
+
+TEST(ScanOdometryTest, SubsampleBySpacingKeepsPointsAtLeastSpacingApart) {
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 100; ++i) points.emplace_back(0.01 * i, 0.0);  // 1 cm apart
+  const auto kept = ScanOdometry::SubsampleBySpacing(points, 0.025);
+  ASSERT_EQ(kept.size(), 34u);  // 0, 3, 6, ... 99 cm
+  for (std::size_t i = 1; i < kept.size(); ++i) {
+    EXPECT_GE((kept[i] - kept[i - 1]).norm(), 0.025);
+  }
+  EXPECT_EQ(ScanOdometry::SubsampleBySpacing(points, 0.0).size(), 100u);
+  EXPECT_TRUE(ScanOdometry::SubsampleBySpacing({}, 0.03).empty());
+}
+
+}  // namespace
+}  // namespace keyplace
