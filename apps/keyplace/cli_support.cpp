@@ -12,6 +12,15 @@
 
 namespace keyplace::cli {
 
+CarmenLog ReadLogWithScans(const std::string& path) {
+  CarmenLog log = ReadCarmenLog(path);
+  if (log.scans.empty()) {
+    throw std::invalid_argument(path + ": no laser scans (FLASER or ROBOTLASER1 lines) in " +
+                                std::to_string(log.lines) + " lines: is this a CARMEN log?");
+  }
+  return log;
+}
+
 void WriteJson(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }

@@ -7,7 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "keyplace/io/carmen_log.hpp"
+
 namespace keyplace::cli {
+
+/// Reads a CARMEN log and throws std::invalid_argument when it holds no laser scans (so that a
+/// wrong file is reported instead of giving empty results).
+CarmenLog ReadLogWithScans(const std::string& path);
 
 /// Writes `json` (pretty-printed) to `path` atomically.
 void WriteJson(const std::string& path, const nlohmann::json& json);

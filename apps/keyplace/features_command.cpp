@@ -29,7 +29,7 @@ struct FeaturesOptions {
 };
 
 void RunFeatures(const FeaturesOptions& options) {
-  const CarmenLog log = ReadCarmenLog(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input);
   const ScanRange range = ParseScanRange(options.scans, log.scans.size());
   const FlirtExtractor extractor;
 

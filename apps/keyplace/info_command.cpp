@@ -101,7 +101,7 @@ void PrintLog(const nlohmann::json& json) {
 }
 
 void RunInfo(const InfoOptions& options) {
-  const CarmenLog log = ReadCarmenLog(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input);
   const nlohmann::json json = DescribeLog(log);
   PrintLog(json);
   if (!options.json_path.empty()) WriteJson(options.json_path, json);

@@ -1,13 +1,15 @@
 // keyplace: place recognition with stable 2D-LiDAR keypoints (command-line front end).
 
+#include <cstdio>
 #include <exception>
 
-#include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Run(int argc, char** argv) {
   CLI::App app{
       "keyplace: compact maps of stable FLIRT keypoints from 2D laser logs, and place recognition "
       "(global localization, loop closure) against them.\n"
@@ -22,9 +24,19 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     return app.exit(error);
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "keyplace: error: {}\n", error.what());
-    return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "keyplace: error: %s\n", error.what());
+  } catch (...) {
+    std::fprintf(stderr, "keyplace: error: unknown exception\n");
+  }
+  return 1;
 }

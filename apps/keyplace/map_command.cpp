@@ -49,7 +49,7 @@ void RunMap(const MapOptions& options) {
   }
   ApplyKeyValues(ParseAssignments(options.assignments), config);
 
-  const CarmenLog log = ReadCarmenLog(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input);
   const PoseSource source = options.poses.empty()
                                 ? (log.corrected ? PoseSource::kCorrected : PoseSource::kIcp)
                                 : ParsePoseSource(options.poses);

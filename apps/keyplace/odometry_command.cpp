@@ -138,7 +138,7 @@ void RunOdometry(OdometryOptions options) {
     throw std::invalid_argument("--corrected and --raw-to-corrected must be given together");
   }
 
-  const CarmenLog log = ReadCarmenLog(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input);
   // Processing order: file order, or sorted (stably) by logger or ipc timestamp.
   std::vector<std::size_t> order(log.scans.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -279,7 +279,7 @@ void RunOdometry(OdometryOptions options) {
   }
 
   if (!options.corrected_path.empty()) {
-    const CarmenLog corrected = ReadCarmenLog(options.corrected_path);
+    const CarmenLog corrected = ReadLogWithScans(options.corrected_path);
     std::vector<Pose2> corrected_poses;
     for (const LaserScan& scan : corrected.scans) {
       if (!scan.corrected_pose) {

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# End-to-end checks of the keyplace command line on the bundled log: help texts, outputs, and
+# clear errors for bad input. Usage: cli_test.sh KEYPLACE_BINARY SOURCE_DIR
+set -uo pipefail
+keyplace=$1
+source_dir=$2
+log="$source_dir/data/fr079-corrected.log.gz"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+
+check() {  # check NAME COMMAND...: the command must succeed
+  local name=$1
+  shift
+  if "$@" >"$work/out" 2>"$work/err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name"
+    sed 's/^/  | /' "$work/out" "$work/err" | head -20
+  fi
+}
+
+fails_with() {  # fails_with NAME FRAGMENT COMMAND...: must fail, stderr containing FRAGMENT
+  local name=$1 fragment=$2
+  shift 2
+  if "$@" >"$work/out" 2>"$work/err"; then
+    failed=$((failed + 1))
+    echo "FAILED: $name (succeeded, expected an error)"
+  elif grep -qF -- "$fragment" "$work/err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name (error does not mention '$fragment')"
+    sed 's/^/  | /' "$work/err" | head -10
+  fi
+}
+
+json_value() {  # json_value FILE KEY: a top-level number or string of a JSON file
+  python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"
+}
+
+check "help" "$keyplace" --help
+for command in info features odometry map; do
+  check "$command --help" "$keyplace" "$command" --help
+done
+
+check "info" "$keyplace" info "$log" --json "$work/info.json"
+check "info scans" test "$(json_value "$work/info.json" scans)" = 1464
+check "info beams" test "$(json_value "$work/info.json" beams_per_scan_max)" = 360
+
+check "features" "$keyplace" features "$log" --scans 0:20 --tsv "$work/kp.tsv" --json "$work/kp.json"
+check "features tsv header" test "$(head -1 "$work/kp.tsv")" = "$(printf 'scan\tx\ty\torientation\tscale')"
+check "features scans" test "$(json_value "$work/kp.json" scans)" = 20
+check "features tsv rows = keypoints" test "$(($(wc -l <"$work/kp.tsv") - 1))" = \
+  "$(json_value "$work/kp.json" keypoints)"
+check "features json keys" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert j['keypoints_per_scan_mean'] > 5 and j['seconds_per_scan_mean'] > 0" "$work/kp.json"
+
+printf 'not a log\n' >"$work/text.log"
+fails_with "non-log input" "no laser scans" "$keyplace" info "$work/text.log"
+printf 'FLASER 3 1.0 2.0 0 0 0 0 0 0 1 h 1\n' >"$work/bad.log"
+fails_with "bad beam count" "bad.log:1" "$keyplace" features "$work/bad.log"
+fails_with "bad scan range" "--scans" "$keyplace" features "$log" --scans 5:x
+fails_with "missing file" "does not exist" "$keyplace" info "$work/missing.log"
+fails_with "bad pose source" "--poses" "$keyplace" map "$log" --poses gps
+fails_with "bad --set key" "unknown key 'no_such'" "$keyplace" map "$log" --set no_such=1
+
+# A failed run must not clobber an existing output file.
+echo precious >"$work/keep.json"
+"$keyplace" features "$work/bad.log" --json "$work/keep.json" >/dev/null 2>&1
+check "output kept on failure" test "$(cat "$work/keep.json")" = precious
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
