@@ -12,6 +12,7 @@ namespace keyplace::features_internal {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Squared distances carry a few ulp of error: candidates within this relative margin of the
 // current key are compared exactly.
 constexpr double kGateSlack = 1.0 + kCloseRelative;
@@ -68,23 +69,13 @@ void BuildCsr(int n, const std::vector<int>& a, const std::vector<int>& b,
   }
 }
 
-// One round of Prim's algorithm from vertex 0 on the complete Euclidean graph minus the edges
-// already taken (and minus the edge (0, n-1)); appends the tree edges to the workspace edge list
-// as (parent, vertex) in vertex order, like FLIRTLib.
-//
+// Slow path of PrimRound (used only when two candidate edges are exactly equal at a selection):
 // FLIRTLib runs Boost's prim_minimum_spanning_tree on an adjacency matrix with hypot(dx, dy)
 // weights. We follow its visiting order, strict comparisons and 4-ary heap, so that exactly
 // equal edge lengths -- common with centimetre ranges on regular structures -- resolve the same
 // way. Keys are kept as squared distances; whenever two of them are too close for their order
 // to be certain, the comparison falls back to the exact hypot values (EdgeLess). Dense O(n^2).
-void PrimRound(int n, CurvatureWorkspace& ws) {
-  // Removed edges = the union so far plus (0, n-1).
-  ws.edge_a.push_back(0);
-  ws.edge_b.push_back(n - 1);
-  BuildCsr(n, ws.edge_a, ws.edge_b, ws.removed_offsets, ws.removed_targets, ws.removed_fill);
-  ws.edge_a.pop_back();
-  ws.edge_b.pop_back();
-
+void PrimRoundBoostOrder(int n, CurvatureWorkspace& ws) {
   const double* x = ws.x.data();
   const double* y = ws.y.data();
   ws.prim_key2.assign(n, kInf);
@@ -136,6 +127,125 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
       gate[ws.removed_targets[r]] = ws.prim_saved_gate[r - removed_begin];
     }
   }
+}
+
+// Fast path of PrimRound: textbook dense Prim with the not-yet-connected vertices in compact
+// arrays. Keys are squared distances, compared exactly (EdgeLess) when close. As long as every
+// selection has a unique minimum the result is the one of any correct Prim, in particular of
+// Boost's. Returns false, with the parents unusable, when a selection meets an exact tie.
+bool PrimRoundUniqueMinima(int n, CurvatureWorkspace& ws) {
+  int m = n - 1;  // vertices not in the tree, at compact positions 0..m-1
+  ws.prim_vertex.resize(n);
+  ws.prim_position.resize(n);
+  ws.prim_x.resize(n);
+  ws.prim_y.resize(n);
+  ws.prim_key2.assign(n, kInf);
+  ws.prim_key_parent.resize(n);
+  ws.prim_parent.resize(n);
+  for (int v = 0; v < n; ++v) ws.prim_parent[v] = v;
+  ws.prim_position[0] = -1;
+  for (int v = 1; v < n; ++v) {
+    ws.prim_vertex[v - 1] = v;
+    ws.prim_position[v] = v - 1;
+    ws.prim_x[v - 1] = ws.x[v];
+    ws.prim_y[v - 1] = ws.y[v];
+    ws.prim_key_parent[v - 1] = v;
+  }
+  const double* x = ws.x.data();
+  const double* y = ws.y.data();
+  int* vertex = ws.prim_vertex.data();
+  double* px = ws.prim_x.data();
+  double* py = ws.prim_y.data();
+  double* key2 = ws.prim_key2.data();           // by compact position
+  int* key_parent = ws.prim_key_parent.data();  // by compact position
+  int* parent = ws.prim_parent.data();          // by vertex, set when it joins the tree
+
+  int u = 0;
+  while (m > 0) {
+    const double ux = x[u];
+    const double uy = y[u];
+    // Edges removed from the complete graph: hide their endpoints for this step (a NaN
+    // coordinate fails every comparison).
+    const int removed_begin = ws.removed_offsets[u];
+    const int removed_end = ws.removed_offsets[u + 1];
+    for (int r = removed_begin; r < removed_end; ++r) {
+      const int p = ws.prim_position[ws.removed_targets[r]];
+      if (p >= 0) px[p] = kNaN;
+    }
+    // Relax the edges from u and select the smallest key, tracking the runner-up to detect
+    // near-equal minima. Clear decisions are branch-free; near-equal keys take the exact path.
+    double min1 = kInf, min2 = kInf;
+    int best = -1;
+    for (int p = 0; p < m; ++p) {
+      const double dx = px[p] - ux;
+      const double dy = py[p] - uy;
+      const double d2 = dx * dx + dy * dy;
+      double key = key2[p];
+      const bool shorter = d2 < key * (1.0 - kCloseRelative);
+      key = shorter ? d2 : key;
+      key_parent[p] = shorter ? u : key_parent[p];
+      if (__builtin_expect(!shorter && d2 <= key * (1.0 + kCloseRelative), 0)) {
+        if (EdgeLess(x, y, u, vertex[p], d2, key_parent[p], vertex[p], key)) {
+          key = d2;
+          key_parent[p] = u;
+        }
+      }
+      key2[p] = key;
+      const bool smallest = key < min1;
+      min2 = smallest ? min1 : (key < min2 ? key : min2);
+      min1 = smallest ? key : min1;
+      best = smallest ? p : best;
+    }
+    for (int r = removed_begin; r < removed_end; ++r) {
+      const int t = ws.removed_targets[r];
+      const int p = ws.prim_position[t];
+      if (p >= 0) px[p] = x[t];
+    }
+    if (best < 0) break;  // the rest is unreachable (only in tiny point sets)
+    if (min2 <= min1 * (1.0 + kCloseRelative)) {
+      // Near-equal minima: order them by the exact weights; an exact tie is left to the
+      // Boost-order emulation.
+      const int bv = vertex[best];
+      const double best_weight =
+          std::hypot(x[bv] - x[key_parent[best]], y[bv] - y[key_parent[best]]);
+      for (int p = 0; p < m; ++p) {
+        if (p == best || !(key2[p] <= min1 * (1.0 + kCloseRelative))) continue;
+        const int v = vertex[p];
+        const double weight = std::hypot(x[v] - x[key_parent[p]], y[v] - y[key_parent[p]]);
+        if (!(best_weight < weight)) return false;
+      }
+    }
+    const int v = vertex[best];
+    parent[v] = key_parent[best];
+    // Remove `best` from the compact arrays (swap with the last).
+    const int last = m - 1;
+    vertex[best] = vertex[last];
+    px[best] = px[last];
+    py[best] = py[last];
+    key2[best] = key2[last];
+    key_parent[best] = key_parent[last];
+    ws.prim_position[vertex[best]] = best;
+    ws.prim_position[v] = -1;
+    --m;
+    u = v;
+  }
+  return true;
+}
+
+// One round of Prim's algorithm from vertex 0 on the complete Euclidean graph minus the edges
+// already taken (and minus the edge (0, n-1)); appends the tree edges to the workspace edge list
+// as (parent, vertex) in vertex order, like FLIRTLib.
+void PrimRound(int n, CurvatureWorkspace& ws) {
+  ws.edge_a.push_back(0);
+  ws.edge_b.push_back(n - 1);
+  BuildCsr(n, ws.edge_a, ws.edge_b, ws.removed_offsets, ws.removed_targets, ws.removed_fill);
+  ws.edge_a.pop_back();
+  ws.edge_b.pop_back();
+  if (!PrimRoundUniqueMinima(n, ws)) {
+    ++ws.prim_fallbacks;
+    PrimRoundBoostOrder(n, ws);
+  }
+  const int* parent = ws.prim_parent.data();
   for (int v = 1; v < n; ++v) {
     if (parent[v] == v) continue;  // unreachable (only in tiny point sets)
     ws.edge_a.push_back(parent[v]);
@@ -143,84 +253,94 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
   }
 }
 
-// Dijkstra from every vertex on the spanning-tree union, truncated at the largest radius. Row i
-// holds the settled vertices j > i (each pair once) in settle order, i.e. by non-decreasing
-// distance, with their squared distance; row_scale_count[i * L + l] is the length of the prefix
-// within radii[l].
-// The graph is nearly a chain, so the frontier stays small (about 5-10 vertices): an unsorted
-// array with a linear minimum search beats a heap here.
+// Geodesic distances from every vertex on the spanning-tree union, truncated at the largest
+// radius. Row i lists each vertex j > i within the radius once, with its squared distance, grouped
+// by scale band: row_scale_count[i * L + l] entries first are those within radii[l].
+//
+// Label-correcting search (FIFO queue) instead of Dijkstra: the graph is nearly a chain and the
+// queue order nearly follows the distance, so few vertices are visited twice, and there is no
+// heap. The labels converge to the same shortest-path sums.
 void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWorkspace& ws) {
   const int num_scales = static_cast<int>(radii.size());
   const double max_radius = radii.back();
+  double radii2[kMaxScales];
+  for (int l = 0; l < num_scales; ++l) radii2[l] = radii[l] * radii[l];
   ws.row_offsets.assign(static_cast<std::size_t>(n) + 1, 0);
   ws.row_scale_count.resize(static_cast<std::size_t>(n) * num_scales);
   ws.row_vertex.clear();
   ws.row_dist2.clear();
-  ws.dijkstra_dist.resize(n);
-  ws.dijkstra_stamp.assign(n, -1);
-  ws.dijkstra_slot.resize(n);
-  ws.frontier_vertex.resize(n);
-  ws.frontier_dist.resize(n);
-  double* dist = ws.dijkstra_dist.data();
-  int* stamp = ws.dijkstra_stamp.data();
-  int* slot = ws.dijkstra_slot.data();  // frontier position, or -1 once settled
-  int* frontier_vertex = ws.frontier_vertex.data();
-  double* frontier_dist = ws.frontier_dist.data();
+  ws.labels.assign(n, GeodesicLabel{0.0, -1, 0});
+  ws.queue.resize(static_cast<std::size_t>(n) + 1);
+  ws.touched.resize(n);
+  ws.touched_band.resize(n);
+  GeodesicLabel* label = ws.labels.data();
+  int* queue = ws.queue.data();  // ring buffer of capacity n + 1
+  int* touched = ws.touched.data();
+  int* touched_band = ws.touched_band.data();
+  const int capacity = n + 1;
   const int* adj_offsets = ws.adj_offsets.data();
-  const int* adj_targets = ws.adj_targets.data();
-  const double* adj_weights = ws.adj_weights.data();
+  const AdjacentVertex* adjacent = ws.adjacent.data();
+  int band_start[kMaxScales];
 
   for (int source = 0; source < n; ++source) {
-    const std::size_t row_begin = ws.row_vertex.size();
-    stamp[source] = source;
-    dist[source] = 0.0;
-    slot[source] = 0;
-    frontier_vertex[0] = source;
-    frontier_dist[0] = 0.0;
-    int frontier_size = 1;
-    while (frontier_size > 0) {
-      int best = 0;
-      for (int f = 1; f < frontier_size; ++f) {
-        if (frontier_dist[f] < frontier_dist[best]) best = f;
-      }
-      const int v = frontier_vertex[best];
-      const double d = frontier_dist[best];
-      --frontier_size;
-      frontier_vertex[best] = frontier_vertex[frontier_size];
-      frontier_dist[best] = frontier_dist[frontier_size];
-      slot[frontier_vertex[best]] = best;
-      slot[v] = -1;
-      if (v > source) {
-        ws.row_vertex.push_back(v);
-        ws.row_dist2.push_back(d * d);
-      }
+    int num_touched = 0;
+    label[source] = GeodesicLabel{0.0, source, 1};
+    touched[num_touched++] = source;
+    int head = 0, tail = 0;
+    queue[tail++] = source;
+    while (head != tail) {
+      const int v = queue[head];
+      head = head + 1 == capacity ? 0 : head + 1;
+      label[v].queued = 0;
+      const double d = label[v].dist;
       for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
-        const int t = adj_targets[e];
-        const double nd = d + adj_weights[e];
+        const double nd = d + adjacent[e].weight;
         if (nd > max_radius) continue;
-        if (stamp[t] != source) {
-          stamp[t] = source;
-          dist[t] = nd;
-          slot[t] = frontier_size;
-          frontier_vertex[frontier_size] = t;
-          frontier_dist[frontier_size] = nd;
-          ++frontier_size;
-        } else if (nd < dist[t] && slot[t] >= 0) {
-          dist[t] = nd;
-          frontier_dist[slot[t]] = nd;
+        GeodesicLabel& target = label[adjacent[e].vertex];
+        if (target.stamp != source) {
+          target.stamp = source;
+          touched[num_touched++] = adjacent[e].vertex;
+        } else if (!(nd < target.dist)) {
+          continue;
+        }
+        target.dist = nd;
+        if (!target.queued) {
+          target.queued = 1;
+          queue[tail] = adjacent[e].vertex;
+          tail = tail + 1 == capacity ? 0 : tail + 1;
         }
       }
     }
-    const std::size_t row_end = ws.row_vertex.size();
-    ws.row_offsets[source + 1] = static_cast<int>(row_end);
-    // Prefix lengths per scale (rows are sorted by distance).
-    std::size_t k = row_begin;
-    for (int l = 0; l < num_scales; ++l) {
-      const double r2 = radii[l] * radii[l];
-      while (k < row_end && ws.row_dist2[k] <= r2) ++k;
-      ws.row_scale_count[static_cast<std::size_t>(source) * num_scales + l] =
-          static_cast<int>(k - row_begin);
+    // Row: the vertices j > source, grouped by scale band (counting sort).
+    int band_count[kMaxScales] = {};
+    for (int k = 0; k < num_touched; ++k) {
+      const int t = touched[k];
+      if (t <= source) continue;
+      const double d2 = label[t].dist * label[t].dist;
+      int band = 0;
+      while (d2 > radii2[band]) ++band;  // d <= max_radius, so band < num_scales
+      touched_band[k] = band;
+      ++band_count[band];
     }
+    const std::size_t row_begin = ws.row_vertex.size();
+    int total = 0;
+    for (int l = 0; l < num_scales; ++l) {
+      band_start[l] = total;
+      total += band_count[l];
+      ws.row_scale_count[static_cast<std::size_t>(source) * num_scales + l] = total;
+    }
+    ws.row_vertex.resize(row_begin + total);
+    ws.row_dist2.resize(row_begin + total);
+    int* row_vertex = ws.row_vertex.data() + row_begin;
+    double* row_dist2 = ws.row_dist2.data() + row_begin;
+    for (int k = 0; k < num_touched; ++k) {
+      const int t = touched[k];
+      if (t <= source) continue;
+      const int slot = band_start[touched_band[k]]++;
+      row_vertex[slot] = t;
+      row_dist2[slot] = label[t].dist * label[t].dist;
+    }
+    ws.row_offsets[source + 1] = static_cast<int>(ws.row_vertex.size());
   }
 }
 
@@ -244,13 +364,13 @@ void ComputeCurvature(const CurvatureParams& params, CurvatureWorkspace& ws,
                                    ws.y[ws.edge_a[e]] - ws.y[ws.edge_b[e]]);
   }
   BuildCsr(n, ws.edge_a, ws.edge_b, ws.adj_offsets, ws.adj_targets, ws.adj_fill);
-  ws.adj_weights.resize(ws.adj_targets.size());
+  ws.adjacent.resize(ws.adj_targets.size());
   {
     std::vector<int>& fill = ws.adj_fill;
     fill.assign(ws.adj_offsets.begin(), ws.adj_offsets.end() - 1);
     for (std::size_t e = 0; e < ws.edge_a.size(); ++e) {
-      ws.adj_weights[fill[ws.edge_a[e]]++] = ws.edge_weight[e];
-      ws.adj_weights[fill[ws.edge_b[e]]++] = ws.edge_weight[e];
+      ws.adjacent[fill[ws.edge_a[e]]++] = AdjacentVertex{ws.edge_weight[e], ws.edge_b[e]};
+      ws.adjacent[fill[ws.edge_b[e]]++] = AdjacentVertex{ws.edge_weight[e], ws.edge_a[e]};
     }
   }
 

@@ -112,12 +112,28 @@ struct PrimKeyOrder {
   }
 };
 
+constexpr int kMaxScales = 32;
+
+struct AdjacentVertex {
+  double weight;
+  int vertex;
+};
+
+/// Tentative geodesic distance of a vertex in the search from `stamp` (the current source).
+struct GeodesicLabel {
+  double dist;
+  int stamp;
+  int queued;
+};
+
 /// Scratch buffers of the detector, reused between scans (one per thread).
 struct CurvatureWorkspace {
   // Vertex positions (valid beams in scan order).
   std::vector<double> x, y;
   // Prim.
-  std::vector<int> prim_parent;
+  std::vector<int> prim_parent, prim_vertex, prim_position, prim_key_parent;
+  std::vector<double> prim_x, prim_y;
+  long prim_fallbacks = 0;  // rounds that needed the exact Boost-order emulation
   std::vector<double> prim_key2, prim_gate, prim_saved_gate;
   QuaternaryHeap<PrimKeyOrder> prim_heap;
   // Edges of the spanning-tree union (and its CSR adjacency).
@@ -125,12 +141,12 @@ struct CurvatureWorkspace {
   std::vector<double> edge_weight;
   std::vector<int> removed_offsets, removed_targets, removed_fill;
   std::vector<int> adj_offsets, adj_targets, adj_fill;
-  std::vector<double> adj_weights;
+  std::vector<AdjacentVertex> adjacent;
   // Truncated geodesic rows: for each source, the vertices within the cutoff in settle order.
   std::vector<int> row_offsets, row_vertex, row_scale_count;
   std::vector<double> row_dist2;
-  std::vector<double> dijkstra_dist, frontier_dist;
-  std::vector<int> dijkstra_stamp, dijkstra_slot, frontier_vertex;
+  std::vector<GeodesicLabel> labels;
+  std::vector<int> queue, touched, touched_band;
   // Smoothing.
   std::vector<double> kernel, density, inv_density, sum_w, sum_wx, sum_wy;
 };
