@@ -17,10 +17,12 @@ std::int64_t DistributionKey(const Eigen::Vector2d& point_m, double cell_m) {
 // delta from the two sets of occupied cells of D; every keypoint cell normally holds laser
 // points too (keypoints are beam endpoints), but the formula does not rely on it.
 double DistributionFromCells(const std::unordered_set<std::int64_t>& laser_cells,
-                             const std::unordered_set<std::int64_t>& keypoint_cells) {
+                             std::size_t laser_population,
+                             const std::unordered_set<std::int64_t>& keypoint_cells,
+                             std::size_t keypoint_population) {
   if (keypoint_cells.empty() || laser_cells.empty()) return 1.0;
-  const double q = 1.0 / static_cast<double>(laser_cells.size());
-  const double p = 1.0 / static_cast<double>(keypoint_cells.size());
+  const double q = 1.0 / static_cast<double>(laser_population);
+  const double p = 1.0 / static_cast<double>(keypoint_population);
   double distance = 0.0;
   std::size_t shared = 0;
   for (const auto cell : keypoint_cells) {
@@ -38,12 +40,18 @@ double DistributionFromCells(const std::unordered_set<std::int64_t>& laser_cells
 }  // namespace
 
 double DistributionDistance(const std::vector<Eigen::Vector2d>& laser_points_m,
-                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m) {
+                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m,
+                            MappingConfig::DistributionNormalization normalization) {
   std::unordered_set<std::int64_t> laser_cells;
   std::unordered_set<std::int64_t> keypoint_cells;
   for (const auto& point : laser_points_m) laser_cells.insert(DistributionKey(point, cell_m));
   for (const auto& point : keypoints_m) keypoint_cells.insert(DistributionKey(point, cell_m));
-  return DistributionFromCells(laser_cells, keypoint_cells);
+  if (normalization == MappingConfig::DistributionNormalization::kCells) {
+    return DistributionFromCells(laser_cells, laser_cells.size(), keypoint_cells,
+                                 keypoint_cells.size());
+  }
+  return DistributionFromCells(laser_cells, laser_points_m.size(), keypoint_cells,
+                               keypoints_m.size());
 }
 
 LocalMapper::LocalMapper(const MappingConfig& config) : config_(config), grid_(config) {}
@@ -54,6 +62,7 @@ void LocalMapper::Reset() {
   poses_.clear();
   stable_.clear();
   hit_cells_.clear();
+  laser_points_ = 0;
   initial_cells_ = 0;
   overlap_ = 1.0;
   distribution_ = 1.0;
@@ -75,6 +84,7 @@ bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_
     if (scan.valid[i] != 0) endpoints_m.push_back(T_submap_laser * scan.Endpoint(i));
   }
   grid_.InsertRays(T_submap_laser.translation(), endpoints_m, static_cast<int>(poses_.size()) - 1);
+  laser_points_ += endpoints_m.size();
   hit_cells_.insert(hit_cells_.end(), grid_.newly_hit_cells().begin(),
                     grid_.newly_hit_cells().end());
   for (const Keypoint& keypoint : keypoints) {
@@ -119,7 +129,13 @@ void LocalMapper::UpdateCompletion() {
     if (which == LaserCells::kPersistent && counts.scans_hit < config_.min_scan_count) continue;
     laser_cells.insert(DistributionKey(grid_.CellCenter(cell), config_.distribution_cell_m));
   }
-  distribution_ = DistributionFromCells(laser_cells, keypoint_cells);
+  if (config_.distribution_normalization == MappingConfig::DistributionNormalization::kCells) {
+    distribution_ = DistributionFromCells(laser_cells, laser_cells.size(), keypoint_cells,
+                                          keypoint_cells.size());
+  } else {
+    distribution_ =
+        DistributionFromCells(laser_cells, laser_points_, keypoint_cells, stable_.size());
+  }
   complete_ = overlap_ < config_.min_overlap &&
               (!config_.use_distribution || distribution_ <= config_.max_distribution) &&
               static_cast<int>(stable_.size()) >= config_.min_stable_keypoints;

@@ -86,6 +86,9 @@ std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig
        c.distribution_laser_cells == MappingConfig::LaserCells::kHit        ? "hit"
        : c.distribution_laser_cells == MappingConfig::LaserCells::kOccupied ? "occupied"
                                                                             : "persistent"},
+      {"distribution_normalization",
+       c.distribution_normalization == MappingConfig::DistributionNormalization::kPoints ? "points"
+                                                                                         : "cells"},
       {"min_stable_keypoints", std::to_string(c.min_stable_keypoints)},
       {"max_scans_per_submap", std::to_string(c.max_scans_per_submap)},
   };
@@ -146,6 +149,15 @@ void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingCon
       } else {
         throw std::invalid_argument("MappingConfig.distribution_laser_cells: '" + text +
                                     "' is not hit, occupied or persistent");
+      }
+    } else if (key == "distribution_normalization") {
+      if (text == "points") {
+        c.distribution_normalization = MappingConfig::DistributionNormalization::kPoints;
+      } else if (text == "cells") {
+        c.distribution_normalization = MappingConfig::DistributionNormalization::kCells;
+      } else {
+        throw std::invalid_argument("MappingConfig.distribution_normalization: '" + text +
+                                    "' is not points or cells");
       }
     } else if (key == "min_stable_keypoints") {
       c.min_stable_keypoints = ParseInt(key, text);

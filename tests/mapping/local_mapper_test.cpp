@@ -36,13 +36,22 @@ LaserScan SquareRoomScan(const Pose2& laser_in_world, double half_side_m, int be
 }
 
 TEST(DistributionDistance, HandComputedCases) {
+  constexpr auto kCells = MappingConfig::DistributionNormalization::kCells;
+  constexpr auto kPoints = MappingConfig::DistributionNormalization::kPoints;
   const std::vector<Eigen::Vector2d> laser = {{0.1, 0.1}, {0.6, 0.1}, {1.1, 0.1}, {1.6, 0.1}};
   // One keypoint cell among four laser cells: q = 1/4, p = 1:
   // 0.5 (3/4)^2 / (5/4) + 3 * 0.5 * 1/4 = 0.225 + 0.375.
-  EXPECT_NEAR(DistributionDistance(laser, {{0.2, 0.2}}, 0.5), 0.6, 1e-12);
-  EXPECT_NEAR(DistributionDistance(laser, laser, 0.5), 0.0, 1e-12);
-  EXPECT_NEAR(DistributionDistance(laser, {{10.0, 10.0}}, 0.5), 1.0, 1e-12);
-  EXPECT_NEAR(DistributionDistance(laser, {}, 0.5), 1.0, 1e-12);
+  EXPECT_NEAR(DistributionDistance(laser, {{0.2, 0.2}}, 0.5, kCells), 0.6, 1e-12);
+  EXPECT_NEAR(DistributionDistance(laser, laser, 0.5, kCells), 0.0, 1e-12);
+  EXPECT_NEAR(DistributionDistance(laser, {{10.0, 10.0}}, 0.5, kCells), 1.0, 1e-12);
+  EXPECT_NEAR(DistributionDistance(laser, {}, 0.5, kCells), 1.0, 1e-12);
+  // Divided by the number of points: 8 laser points in 4 cells (q = 1/8 per cell), two
+  // keypoints in one cell (p = 1/2): 0.5 (3/8)^2 / (5/8) + 3 * 0.5 / 8 = 0.1125 + 0.1875.
+  std::vector<Eigen::Vector2d> doubled = laser;
+  doubled.insert(doubled.end(), laser.begin(), laser.end());
+  EXPECT_NEAR(DistributionDistance(doubled, {{0.2, 0.2}, {0.3, 0.3}}, 0.5, kPoints), 0.3, 1e-12);
+  // Disjoint histograms reach the maximum 1 only when every point has a cell of its own.
+  EXPECT_NEAR(DistributionDistance(laser, {{10.0, 10.0}}, 0.5, kPoints), 1.0, 1e-12);
 }
 
 class OverlapTest : public ::testing::TestWithParam<MappingConfig::OverlapCells> {};

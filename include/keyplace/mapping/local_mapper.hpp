@@ -14,10 +14,12 @@
 
 namespace keyplace {
 
-/// Spatial distribution distance delta (Eq. 8): symmetric chi2 between the normalised binary
-/// histograms, on a grid of `cell_m`, of the laser points and of the keypoints. In [0, 1].
+/// Spatial distribution distance delta (Eq. 8): symmetric chi2 between the binary histograms, on
+/// a grid of `cell_m`, of the laser points and of the keypoints, each divided by its population
+/// (number of points, or number of occupied cells). In [0, 1].
 double DistributionDistance(const std::vector<Eigen::Vector2d>& laser_points_m,
-                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m);
+                            const std::vector<Eigen::Vector2d>& keypoints_m, double cell_m,
+                            MappingConfig::DistributionNormalization normalization);
 
 class LocalMapper {
  public:
@@ -52,6 +54,7 @@ class LocalMapper {
   std::vector<Pose2> poses_;
   std::vector<StabilityGrid::Selected> stable_;
   std::vector<CellIndex> hit_cells_;  // cells of G hit so far, in order of their first hit
+  std::size_t laser_points_ = 0;      // valid beam endpoints inserted so far
   std::int64_t initial_cells_ = 0;
   double overlap_ = 1.0;
   double distribution_ = 1.0;

@@ -36,7 +36,13 @@ struct MappingConfig {
   // hit by at least ns_min scans (the cells whose keypoints could reach s_min). See
   // docs/MAPPING.md for why the default is kPersistent.
   enum class LaserCells { kHit, kOccupied, kPersistent };
-  LaserCells distribution_laser_cells = LaserCells::kPersistent;
+  LaserCells distribution_laser_cells = LaserCells::kHit;
+  // What the binary histograms are divided by: kPoints = "normalized with the respective
+  // population in each category of points" read literally, the number of laser points and of
+  // stable keypoints (then delta <= 1 as the paper says, and it reproduces the paper's delta);
+  // kCells = the number of occupied cells of each histogram (each sums to 1).
+  enum class DistributionNormalization { kPoints, kCells };
+  DistributionNormalization distribution_normalization = DistributionNormalization::kPoints;
   int min_stable_keypoints = 10;  // and at least this many stable keypoints (Section 5.2)
   // Safety net absent from the paper: a submap that has not met the criteria after this many
   // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
