@@ -17,7 +17,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // current key are compared exactly.
 constexpr double kGateSlack = 1.0 + kCloseRelative;
 
-// exp(-x) for 0 <= x < 700, within about 1 ulp of std::exp but without libm's call and error
+// exp(-x) for x >= 0 (0 beyond 700), within about 2 ulp of std::exp but without libm's call and error
 // handling: exp(-x) = 2^-(m / 128) exp(-r), m = round(128 x / ln 2), with a 128-entry table of
 // 2^-(j / 128) and a degree-5 polynomial on |r| <= ln2 / 256 (truncation error < 1e-18).
 class ExpNegativeTable {
@@ -26,6 +26,7 @@ class ExpNegativeTable {
     for (int j = 0; j < kSize; ++j) table_[j] = std::exp2(-static_cast<double>(j) / kSize);
   }
   double operator()(double x) const {
+    if (!(x < 700.0)) return 0.0;  // below 1e-304: nothing at the scale of the central weight
     const std::int64_t m = static_cast<std::int64_t>(x * kSizeOverLn2 + 0.5);
     const double md = static_cast<double>(m);
     const double r = (x - md * kLn2OverSizeHi) - md * kLn2OverSizeLo;
@@ -382,7 +383,11 @@ void ComputeCurvature(const CurvatureParams& params, CurvatureWorkspace& ws,
   // 1. Union of num_trees successive minimum spanning trees of the complete graph.
   ws.edge_a.clear();
   ws.edge_b.clear();
-  for (int round = 0; round < params.num_trees; ++round) PrimRound(n, ws);
+  ws.tree_end.clear();
+  for (int round = 0; round < params.num_trees; ++round) {
+    PrimRound(n, ws);
+    ws.tree_end.push_back(static_cast<int>(ws.edge_a.size()));
+  }
   ws.edge_weight.resize(ws.edge_a.size());  // the same hypot values Prim compared
   for (std::size_t e = 0; e < ws.edge_a.size(); ++e) {
     ws.edge_weight[e] = std::hypot(ws.x[ws.edge_a[e]] - ws.x[ws.edge_b[e]],

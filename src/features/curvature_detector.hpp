@@ -138,6 +138,7 @@ struct CurvatureWorkspace {
   QuaternaryHeap<PrimKeyOrder> prim_heap;
   // Edges of the spanning-tree union (and its CSR adjacency).
   std::vector<int> edge_a, edge_b;
+  std::vector<int> tree_end;  // end of each spanning tree in the edge list
   std::vector<double> edge_weight;
   std::vector<int> removed_offsets, removed_targets, removed_fill;
   std::vector<int> adj_offsets, adj_targets, adj_fill;

@@ -228,20 +228,31 @@ std::vector<Keypoint> FlirtExtractor::Extract(const LaserScan& scan,
   return keypoints;
 }
 
-FlirtSignals FlirtExtractor::ComputeSignals(const LaserScan& scan) const {
+FlirtSignals FlirtExtractor::ComputeSignals(const LaserScan& scan,
+                                            const Pose2& T_world_laser) const {
   CheckScan(scan);
   FlirtSignals signals;
   signals.sigma_m = sigmas_m_;
   Workspace& ws = ThreadWorkspace();
-  const bool enough = LoadVertices(scan, Pose2(), ws);
+  const bool enough = LoadVertices(scan, T_world_laser, ws);
   signals.beam_of_vertex = ws.beam_of_vertex;
+  const std::size_t n = ws.beam_of_vertex.size();
+  for (std::size_t v = 0; v < n; ++v) {
+    signals.vertices_m.emplace_back(ws.curvature.x[v], ws.curvature.y[v]);
+  }
   const int num_scales = config_.num_scales;
   signals.smoothed_m.resize(num_scales);
   signals.signal.resize(num_scales);
   signals.peak_vertices.resize(num_scales);
   if (!enough) return signals;
   ComputeCurvature(MakeCurvatureParams(config_, sigmas_m_), ws.curvature, ws.curvature_result);
-  const std::size_t n = ws.beam_of_vertex.size();
+  int begin = 0;
+  for (const int end : ws.curvature.tree_end) {
+    auto& tree = signals.spanning_trees.emplace_back();
+    for (int e = begin; e < end; ++e)
+      tree.emplace_back(ws.curvature.edge_a[e], ws.curvature.edge_b[e]);
+    begin = end;
+  }
   for (int level = 0; level < num_scales; ++level) {
     signals.signal[level] = ws.curvature_result.signal[level];
     signals.smoothed_m[level].resize(n);

@@ -7,6 +7,7 @@
 // every reproduced quirk and every deviation are described in docs/FLIRT.md.
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -45,12 +46,16 @@ struct FlirtConfig {
 /// Throws std::invalid_argument naming the first invalid field.
 void ValidateFlirtConfig(const FlirtConfig& config);
 
-/// Intermediate signals of the detector, for diagnostics and oracle tests.
+/// Intermediate results of the detector, for diagnostics and oracle tests.
 struct FlirtSignals {
   std::vector<int> beam_of_vertex;  // graph vertex (valid beam, in scan order) -> beam index
-  std::vector<double> sigma_m;      // per scale
-  // Per scale, per vertex: geodesic-Gaussian smoothed position (laser frame) and the signal
-  // t exp(-t), t = 2 / sigma * |smoothed - position|.
+  // Vertex positions in the frame of the computation (T_world_laser applied, like FLIRTLib).
+  std::vector<Eigen::Vector2d> vertices_m;
+  // The dmst + 1 successive spanning trees whose union is the geodesic graph (vertex pairs).
+  std::vector<std::vector<std::pair<int, int>>> spanning_trees;
+  std::vector<double> sigma_m;  // per scale
+  // Per scale, per vertex: geodesic-Gaussian smoothed position (frame of vertices_m) and the
+  // signal t exp(-t), t = 2 / sigma * |smoothed - position|.
   std::vector<std::vector<Eigen::Vector2d>> smoothed_m;
   std::vector<std::vector<double>> signal;
   std::vector<std::vector<int>> peak_vertices;  // per scale, ascending
@@ -85,8 +90,8 @@ class FlirtExtractor {
   BetaGridDescriptor Describe(const LaserScan& scan, const Eigen::Vector2d& position_m,
                               double orientation_rad) const;
 
-  /// The detector's intermediate signals (slow path with copies; for tests and diagnostics).
-  FlirtSignals ComputeSignals(const LaserScan& scan) const;
+  /// The detector's intermediate results (copies them out; for tests and diagnostics).
+  FlirtSignals ComputeSignals(const LaserScan& scan, const Pose2& T_world_laser = Pose2()) const;
 
  private:
   FlirtConfig config_;

@@ -1,0 +1,236 @@
+// Synthetic tests of the FLIRT detector, descriptor and distance.
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/features/descriptor.hpp"
+#include "keyplace/features/flirt.hpp"
+
+namespace keyplace {
+namespace {
+
+constexpr double kMaxRange = 50.0;
+
+// A 180-degree scan (0.5 deg steps, first beam at -90 deg) of the walls x = 4 and y = 2 seen
+// from the origin: one convex corner at (4, 2).
+LaserScan CornerScan(double angle_offset_rad = 0.0) {
+  LaserScan scan;
+  scan.max_range_m = kMaxRange;
+  for (int i = 0; i < 360; ++i) {
+    const double angle = -M_PI / 2 + i * M_PI / 360;
+    double range = 4.0 / std::cos(angle);
+    if (std::sin(angle) > 0.0) range = std::min(range, 2.0 / std::sin(angle));
+    if (!(range > 0.0) || range > 60.0) range = 81.91;  // no echo
+    scan.angles_rad.push_back(angle + angle_offset_rad);
+    scan.ranges_m.push_back(std::round(range * 100.0) / 100.0);  // centimetre ranges
+    scan.valid.push_back(scan.ranges_m.back() < kMaxRange ? 1 : 0);
+  }
+  return scan;
+}
+
+BetaGridDescriptor Uniform() {
+  BetaGridDescriptor d;
+  d.fill(1.0f / kBetaGridBins);
+  return d;
+}
+
+TEST(SymmetricChi2, ZeroForIdenticalAndSymmetric) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  for (int trial = 0; trial < 20; ++trial) {
+    BetaGridDescriptor a, b;
+    for (int i = 0; i < kBetaGridBins; ++i) {
+      a[i] = uniform(rng);
+      b[i] = i % 5 == 0 ? 0.0f : uniform(rng);
+    }
+    EXPECT_EQ(SymmetricChi2(a, a), 0.0);
+    EXPECT_EQ(SymmetricChi2(a, b), SymmetricChi2(b, a));
+    EXPECT_GT(SymmetricChi2(a, b), 0.0);
+  }
+}
+
+TEST(SymmetricChi2, HandComputedCase) {
+  BetaGridDescriptor a{}, b{};
+  a[0] = 0.5f;
+  a[1] = 0.5f;
+  b[0] = 1.0f;
+  // 0.5 * [(0.5 - 1)^2 / 1.5 + (0.5 - 0)^2 / 0.5], empty bins contribute nothing.
+  EXPECT_NEAR(SymmetricChi2(a, b), 0.5 * (0.25 / 1.5 + 0.5), 1e-12);
+  // Disjoint normalised histograms are at the maximal distance 1.
+  BetaGridDescriptor c{};
+  c[47] = 1.0f;
+  EXPECT_NEAR(SymmetricChi2(b, c), 1.0, 1e-12);
+  EXPECT_NEAR(SymmetricChi2(Uniform(), Uniform()), 0.0, 1e-15);
+}
+
+TEST(SymmetricChi2, EarlyExitAgreesWithFullSum) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  for (int trial = 0; trial < 200; ++trial) {
+    BetaGridDescriptor a, b;
+    for (int i = 0; i < kBetaGridBins; ++i) {
+      a[i] = uniform(rng) / kBetaGridBins;
+      b[i] = uniform(rng) / kBetaGridBins;
+    }
+    const double d = SymmetricChi2(a, b);
+    for (const double threshold : {0.0, 0.5 * d, d, std::nextafter(d, 1.0), 2.0 * d, 1.0}) {
+      EXPECT_EQ(SymmetricChi2Below(a, b, threshold), d < threshold) << d << " " << threshold;
+    }
+  }
+}
+
+TEST(FlirtExtractor, CornerYieldsKeypointNearCorner) {
+  const LaserScan scan = CornerScan();
+  const FlirtExtractor extractor;
+  const std::vector<Keypoint> keypoints = extractor.Extract(scan);
+  ASSERT_FALSE(keypoints.empty());
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Keypoint& k : keypoints) {
+    const double to_corner = (k.position_m - Eigen::Vector2d(4.0, 2.0)).norm();
+    nearest = std::min(nearest, to_corner);
+    EXPECT_LT(to_corner, 0.5);  // the straight walls themselves are not interesting
+    EXPECT_NEAR(k.scale_m, 2.0 * extractor.SigmaM(k.scale_level), 1e-12);
+    EXPECT_GE(k.beam_index, 0);
+    EXPECT_LT(k.beam_index, static_cast<int>(scan.size()));
+    // The keypoint is the endpoint of its beam.
+    EXPECT_NEAR(k.position_m.norm(), scan.ranges_m[k.beam_index], 1e-9);
+  }
+  EXPECT_LT(nearest, 0.1);
+}
+
+TEST(FlirtExtractor, DescriptorsAreNormalisedHistograms) {
+  const FlirtExtractor extractor;
+  const std::vector<Keypoint> keypoints = extractor.Extract(CornerScan());
+  ASSERT_FALSE(keypoints.empty());
+  for (const Keypoint& k : keypoints) {
+    double sum = 0.0;
+    for (const float v : k.descriptor) {
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 1.0f);
+      sum += v;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+  }
+}
+
+TEST(FlirtExtractor, DescriptorSeesTheWalls) {
+  // Around the corner point, looking along +x (orientation 0): the cells straight ahead lie
+  // behind the wall (only misses or untouched), the cells towards the laser are crossed by
+  // rays (misses); the wall cells get hits. So the histogram is far from uniform.
+  const FlirtExtractor extractor;
+  const LaserScan scan = CornerScan();
+  const BetaGridDescriptor d = extractor.Describe(scan, Eigen::Vector2d(4.0, 0.0), 0.0);
+  EXPECT_GT(SymmetricChi2(d, Uniform()), 0.05);
+  // The same point described with a different orientation is a rotated histogram.
+  const BetaGridDescriptor rotated =
+      extractor.Describe(scan, Eigen::Vector2d(4.0, 0.0), M_PI / 6.0);
+  EXPECT_GT(SymmetricChi2(d, rotated), 0.01);
+}
+
+TEST(FlirtExtractor, RotatingTheScanRotatesTheKeypoints) {
+  // Rotating every beam by delta while the world frame stays put (T_world_laser rotated by
+  // -delta) leaves FLIRTLib's world-aligned duplicate box unchanged, so the keypoints must
+  // rotate exactly with the scan.
+  const FlirtExtractor extractor;
+  const double delta = 0.3;
+  const std::vector<Keypoint> a = extractor.Extract(CornerScan(), Pose2());
+  const std::vector<Keypoint> b = extractor.Extract(CornerScan(delta), Pose2(0.0, 0.0, -delta));
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_FALSE(a.empty());
+  const Pose2 rotation(0.0, 0.0, delta);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].beam_index, b[k].beam_index);
+    EXPECT_EQ(a[k].scale_level, b[k].scale_level);
+    EXPECT_LT((rotation * a[k].position_m - b[k].position_m).norm(), 1e-9);
+    EXPECT_NEAR(WrapAngle(a[k].orientation_rad + delta - b[k].orientation_rad), 0.0, 1e-6);
+    EXPECT_LT(SymmetricChi2(a[k].descriptor, b[k].descriptor), 1e-6);
+  }
+}
+
+TEST(FlirtExtractor, TranslatingTheWorldFrameChangesNothing) {
+  const FlirtExtractor extractor;
+  const std::vector<Keypoint> a = extractor.Extract(CornerScan(), Pose2());
+  const std::vector<Keypoint> b = extractor.Extract(CornerScan(), Pose2(12.5, -3.25, 0.0));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].beam_index, b[k].beam_index);
+    EXPECT_NEAR(a[k].orientation_rad, b[k].orientation_rad, 1e-6);
+  }
+}
+
+TEST(FlirtExtractor, DegenerateScansGiveNoKeypoints) {
+  const FlirtExtractor extractor;
+  EXPECT_TRUE(extractor.Extract(LaserScan()).empty());
+
+  LaserScan tiny = CornerScan();
+  tiny.ranges_m.resize(4);
+  tiny.angles_rad.resize(4);
+  tiny.valid.resize(4);
+  EXPECT_TRUE(extractor.Extract(tiny).empty());
+
+  LaserScan no_echo = CornerScan();
+  for (double& r : no_echo.ranges_m) r = 81.91;
+  EXPECT_TRUE(extractor.Extract(no_echo).empty());
+
+  LaserScan broken = CornerScan();
+  for (std::size_t i = 0; i < broken.size(); ++i) {
+    if (i % 40 != 0) broken.ranges_m[i] = std::numeric_limits<double>::quiet_NaN();
+  }
+  EXPECT_NO_THROW(extractor.Extract(broken));
+
+  LaserScan no_max_range = CornerScan();
+  no_max_range.max_range_m = 0.0;
+  EXPECT_TRUE(extractor.Extract(no_max_range).empty());
+
+  // A straight wall has no corner: no keypoint far from the scan borders.
+  LaserScan wall = CornerScan();
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    wall.ranges_m[i] = std::min(81.91, 3.0 / std::cos(wall.angles_rad[i]));
+  }
+  for (const Keypoint& k : extractor.Extract(wall)) EXPECT_GT(k.position_m.norm(), 5.0);
+}
+
+TEST(FlirtExtractor, MismatchedScanThrows) {
+  LaserScan scan = CornerScan();
+  scan.angles_rad.pop_back();
+  EXPECT_THROW(FlirtExtractor().Extract(scan), std::invalid_argument);
+}
+
+void ExpectInvalid(void (*mutate)(FlirtConfig&), const std::string& field) {
+  FlirtConfig config;
+  mutate(config);
+  try {
+    FlirtExtractor extractor(config);
+    ADD_FAILURE() << "no exception for " << field;
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+  }
+}
+
+TEST(FlirtConfig, ValidationNamesTheField) {
+  EXPECT_NO_THROW(FlirtExtractor(FlirtConfig{}));
+  ExpectInvalid([](FlirtConfig& c) { c.num_scales = 0; }, "num_scales");
+  ExpectInvalid([](FlirtConfig& c) { c.base_sigma_m = -0.2; }, "base_sigma_m");
+  ExpectInvalid([](FlirtConfig& c) { c.sigma_step = std::nan(""); }, "sigma_step");
+  ExpectInvalid([](FlirtConfig& c) { c.dmst = -1; }, "dmst");
+  ExpectInvalid([](FlirtConfig& c) { c.min_peak = INFINITY; }, "min_peak");
+  ExpectInvalid([](FlirtConfig& c) { c.min_peak_difference = -1.0; }, "min_peak_difference");
+  ExpectInvalid([](FlirtConfig& c) { c.duplicate_box_m = -0.1; }, "duplicate_box_m");
+  ExpectInvalid([](FlirtConfig& c) { c.kernel_cutoff_sigmas = 0.0; }, "kernel_cutoff_sigmas");
+  ExpectInvalid([](FlirtConfig& c) { c.descriptor_min_rho_m = -1.0; }, "descriptor_min_rho_m");
+  ExpectInvalid([](FlirtConfig& c) { c.descriptor_max_rho_m = 0.01; }, "descriptor_max_rho_m");
+  ExpectInvalid([](FlirtConfig& c) { c.descriptor_radial_border_m = -0.05; },
+                "descriptor_radial_border_m");
+  ExpectInvalid([](FlirtConfig& c) { c.descriptor_angular_border_rad = 1.0; },
+                "descriptor_angular_border_rad");
+}
+
+}  // namespace
+}  // namespace keyplace
