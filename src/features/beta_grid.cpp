@@ -94,15 +94,22 @@ BetaGridDescriptor ComputeBetaGrid(const ScanRays& rays, const Eigen::Vector2d& 
     sin2[p] = std::sin(angle2);
   }
   // Chord vector (end - start) of every arc, per sector and circle, relative to the keypoint.
-  std::array<std::array<double, kCircles>, kPhi> chord_sx, chord_sy, chord_dx, chord_dy;
-  for (int p = 0; p < kPhi; ++p) {
-    for (int c = 0; c < kCircles; ++c) {
-      const double radius = std::sqrt(circle_r2[c]);
-      chord_sx[p][c] = cos1[p] * radius;
-      chord_sy[p][c] = sin1[p] * radius;
-      chord_dx[p][c] = cos2[p] * radius - chord_sx[p][c];
-      chord_dy[p][c] = sin2[p] * radius - chord_sy[p][c];
+  std::array<std::array<double, kPhi>, kCircles> chord_sx, chord_sy, chord_dx, chord_dy;
+  for (int c = 0; c < kCircles; ++c) {
+    const double radius = std::sqrt(circle_r2[c]);
+    for (int p = 0; p < kPhi; ++p) {
+      chord_sx[c][p] = cos1[p] * radius;
+      chord_sy[c][p] = sin1[p] * radius;
+      chord_dx[c][p] = cos2[p] * radius - chord_sx[c][p];
+      chord_dy[c][p] = sin2[p] * radius - chord_sy[c][p];
     }
+  }
+
+  // k x u for every radial line (k = keypoint position, u = line direction).
+  std::array<std::array<double, 2>, kPhi> line_k_cross_u;
+  for (int p = 0; p < kPhi; ++p) {
+    line_k_cross_u[p][0] = kx * sin1[p] - ky * cos1[p];
+    line_k_cross_u[p][1] = kx * sin2[p] - ky * cos2[p];
   }
 
   // FLIRTLib's beam window: the angular interval that covers max_rho around the keypoint.
@@ -156,34 +163,54 @@ BetaGridDescriptor ComputeBetaGrid(const ScanRays& rays, const Eigen::Vector2d& 
       }
     }
 
+    // Crossings with the radial lines (two per sector): the ray meets the line through the
+    // keypoint with direction u at ray parameter t = (k x u) / (d x u) and at distance
+    // s = (k x d) / (d x u) from the keypoint; it crosses the radial segment of ring r when
+    // t is in [0, 1] and s in [inner_r, outer_r]. Tested without dividing.
+    const double k_cross_d = kx * dir_y - ky * dir_x;
+    std::array<std::array<unsigned char, 2>, kPhi> ring_mask;
     for (int p = 0; p < kPhi; ++p) {
-      // Crossing with the two radial lines of the sector: distance s from the keypoint along
-      // the line, valid when the crossing lies on the ray (t in [0, 1]).
-      double s_line[2];
-      bool on_ray[2];
-      const double ux[2] = {cos1[p], cos2[p]};
-      const double uy[2] = {sin1[p], sin2[p]};
       for (int side = 0; side < 2; ++side) {
-        const double denominator = dir_x * uy[side] - dir_y * ux[side];
-        on_ray[side] = false;
-        if (denominator != 0.0) {
-          const double t = (kx * uy[side] - ky * ux[side]) / denominator;
-          s_line[side] = (kx * dir_y - ky * dir_x) / denominator;
-          on_ray[side] = t >= 0.0 && t <= 1.0;
+        const double ux = side == 0 ? cos1[p] : cos2[p];
+        const double uy = side == 0 ? sin1[p] : sin2[p];
+        double denominator = dir_x * uy - dir_y * ux;
+        double t_numerator = line_k_cross_u[p][side];
+        double s_numerator = k_cross_d;
+        if (denominator < 0.0) {
+          denominator = -denominator;
+          t_numerator = -t_numerator;
+          s_numerator = -s_numerator;
         }
-      }
-      for (int r = 0; r < kRho; ++r) {
-        int crossings = 0;
-        for (int side = 0; side < 2; ++side) {
-          crossings += on_ray[side] && s_line[side] >= inner[r] && s_line[side] <= outer[r];
-        }
-        for (const int c : {2 * r, 2 * r + 1}) {
-          for (int k = 0; k < num_points[c]; ++k) {
-            const double dx = ix[c][k] - chord_sx[p][c];
-            const double dy = iy[c][k] - chord_sy[p][c];
-            crossings += dx * chord_dy[p][c] >= dy * chord_dx[p][c];
+        unsigned char mask = 0;
+        if (denominator != 0.0 && t_numerator >= 0.0 && t_numerator <= denominator) {
+          for (int r = 0; r < kRho; ++r) {
+            const bool crosses =
+                s_numerator >= inner[r] * denominator && s_numerator <= outer[r] * denominator;
+            mask |= static_cast<unsigned char>(crosses << r);
           }
         }
+        ring_mask[p][side] = mask;
+      }
+    }
+
+    // Crossings with the arcs: a crossing point of circle c belongs to the arc of sector p
+    // when it lies beyond the arc's chord (FLIRTLib's test; the arcs span less than pi).
+    std::array<std::array<int, kPhi>, kCircles> arc_count{};
+    for (int c = 0; c < kCircles; ++c) {
+      for (int k = 0; k < num_points[c]; ++k) {
+        const double px = ix[c][k];
+        const double py = iy[c][k];
+        for (int p = 0; p < kPhi; ++p) {
+          arc_count[c][p] +=
+              (px - chord_sx[c][p]) * chord_dy[c][p] >= (py - chord_sy[c][p]) * chord_dx[c][p];
+        }
+      }
+    }
+
+    for (int p = 0; p < kPhi; ++p) {
+      for (int r = 0; r < kRho; ++r) {
+        const int crossings = ((ring_mask[p][0] >> r) & 1) + ((ring_mask[p][1] >> r) & 1) +
+                              arc_count[2 * r][p] + arc_count[2 * r + 1][p];
         const int bin = p * kRho + r;
         hit[bin] += crossings == 1;
         miss[bin] += crossings >= 2;

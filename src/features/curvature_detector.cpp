@@ -17,9 +17,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // current key are compared exactly.
 constexpr double kGateSlack = 1.0 + kCloseRelative;
 
-// exp(-x) for x >= 0 (0 beyond 700), within about 2 ulp of std::exp but without libm's call and error
-// handling: exp(-x) = 2^-(m / 128) exp(-r), m = round(128 x / ln 2), with a 128-entry table of
-// 2^-(j / 128) and a degree-5 polynomial on |r| <= ln2 / 256 (truncation error < 1e-18).
+// exp(-x) for x >= 0 (0 beyond 700), within about 2 ulp of std::exp but without libm's call and
+// error handling: exp(-x) = 2^-(m / 128) exp(-r), m = round(128 x / ln 2), with a 128-entry table
+// of 2^-(j / 128) and a degree-5 polynomial on |r| <= ln2 / 256 (truncation error < 1e-18).
 class ExpNegativeTable {
  public:
   ExpNegativeTable() {
