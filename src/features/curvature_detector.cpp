@@ -258,11 +258,12 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
 // radius. Row i lists each vertex j > i within the radius once, with its squared distance, grouped
 // by scale band: row_scale_count[i * L + l] entries first are those within radii[l].
 //
-// Label-correcting search (FIFO queue) instead of Dijkstra: the graph is nearly a chain and the
-// queue order nearly follows the distance, so few vertices are visited twice, and there is no
-// heap. The search from vertex s starts from the upper bounds d(s - 1, v) + d(s, s - 1), i.e.
-// the previous source's distances, so only the vertices whose shortest path does not run
-// through s - 1 (roughly the half ahead of s) are searched again. The labels converge to the
+// Each pair is searched once. The search from s runs on the vertices >= s only, seeded with s
+// itself and with every edge (v, t) that crosses the cut (v < s <= t) at d(s, v) + w(v, t),
+// where d(s, v) = d(v, s) is already known from row v. That is exact: on a shortest path from s
+// to j >= s, the part after its last vertex v < s stays at or above s. The search is
+// label-correcting (FIFO queue): the graph is nearly a chain and the queue order nearly follows
+// the distance, so few vertices are visited twice and no heap is needed. The labels are the
 // shortest-path lengths (equal to Dijkstra's up to the rounding of the sums).
 void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWorkspace& ws) {
   const int num_scales = static_cast<int>(radii.size());
@@ -277,67 +278,86 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
   ws.queue.resize(static_cast<std::size_t>(n) + 1);
   ws.touched.resize(n);
   ws.touched_band.resize(n);
+  // dist_ahead[v * n + j] = d(v, j) for j > v within the radius, +inf otherwise.
+  ws.dist_ahead.assign(static_cast<std::size_t>(n) * n, kInf);
   GeodesicLabel* label = ws.labels.data();
   int* queue = ws.queue.data();  // ring buffer of capacity n + 1
   int* touched = ws.touched.data();
   int* touched_band = ws.touched_band.data();
+  double* dist_ahead = ws.dist_ahead.data();
   const int capacity = n + 1;
   const int* adj_offsets = ws.adj_offsets.data();
   const AdjacentVertex* adjacent = ws.adjacent.data();
   int band_start[kMaxScales];
-
-  ws.previous_vertex.resize(n);
-  ws.previous_dist.resize(n);
-  int* previous_vertex = ws.previous_vertex.data();
-  double* previous_dist = ws.previous_dist.data();
-  int num_previous = 0;
+  // Edges (v, t) with v < s <= t for the current s, as (v, index into adjacent).
+  std::vector<std::pair<int, int>>& crossing = ws.crossing_edges;
+  crossing.clear();
 
   for (int source = 0; source < n; ++source) {
     int num_touched = 0;
-    // Upper bounds through the previous source, when it is within reach.
-    if (source > 0 && label[source].stamp == source - 1) {
-      const double offset = label[source].dist;
-      for (int k = 0; k < num_previous; ++k) {
-        const double bound = previous_dist[k] + offset;
-        if (bound > max_radius) continue;
-        const int v = previous_vertex[k];
-        label[v] = GeodesicLabel{bound, source, 0};
-        touched[num_touched++] = v;
+    int head = 0, tail = 0;
+    label[source] = GeodesicLabel{0.0, source, 1};
+    touched[num_touched++] = source;
+    queue[tail++] = source;
+    // Update the cut: add the edges of source - 1 going up, drop those ending below source.
+    if (source > 0) {
+      const int v = source - 1;
+      for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
+        if (adjacent[e].vertex > v) crossing.emplace_back(v, e);
+      }
+      std::size_t kept = 0;
+      for (const auto& edge : crossing) {
+        if (adjacent[edge.second].vertex >= source) crossing[kept++] = edge;
+      }
+      crossing.resize(kept);
+    }
+    // Seeds through the vertices below source.
+    for (const auto& [v, e] : crossing) {
+      const double d = dist_ahead[static_cast<std::size_t>(v) * n + source] + adjacent[e].weight;
+      if (!(d <= max_radius)) continue;
+      const int t = adjacent[e].vertex;
+      GeodesicLabel& target = label[t];
+      if (target.stamp != source) {
+        target = GeodesicLabel{d, source, 1};
+        touched[num_touched++] = t;
+        queue[tail] = t;
+        tail = tail + 1 == capacity ? 0 : tail + 1;
+      } else if (d < target.dist) {
+        target.dist = d;
       }
     }
-    if (label[source].stamp != source) touched[num_touched++] = source;
-    label[source] = GeodesicLabel{0.0, source, 1};
-    int head = 0, tail = 0;
-    queue[tail++] = source;
     while (head != tail) {
       const int v = queue[head];
       head = head + 1 == capacity ? 0 : head + 1;
       label[v].queued = 0;
       const double d = label[v].dist;
       for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
+        const int t = adjacent[e].vertex;
         const double nd = d + adjacent[e].weight;
-        if (nd > max_radius) continue;
-        GeodesicLabel& target = label[adjacent[e].vertex];
+        if (t < source || nd > max_radius) continue;
+        GeodesicLabel& target = label[t];
         if (target.stamp != source) {
           target.stamp = source;
-          touched[num_touched++] = adjacent[e].vertex;
+          touched[num_touched++] = t;
         } else if (!(nd < target.dist)) {
           continue;
         }
         target.dist = nd;
         if (!target.queued) {
           target.queued = 1;
-          queue[tail] = adjacent[e].vertex;
+          queue[tail] = t;
           tail = tail + 1 == capacity ? 0 : tail + 1;
         }
       }
     }
     // Row: the vertices j > source, grouped by scale band (counting sort).
     int band_count[kMaxScales] = {};
-    for (int k = 0; k < num_touched; ++k) {
+    double* ahead = dist_ahead + static_cast<std::size_t>(source) * n;
+    for (int k = 1; k < num_touched; ++k) {  // touched[0] is the source
       const int t = touched[k];
-      if (t <= source) continue;
-      const double d2 = label[t].dist * label[t].dist;
+      const double d = label[t].dist;
+      ahead[t] = d;
+      const double d2 = d * d;
       int band = 0;
       while (d2 > radii2[band]) ++band;  // d <= max_radius, so band < num_scales
       touched_band[k] = band;
@@ -354,19 +374,13 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
     ws.row_dist2.resize(row_begin + total);
     int* row_vertex = ws.row_vertex.data() + row_begin;
     double* row_dist2 = ws.row_dist2.data() + row_begin;
-    for (int k = 0; k < num_touched; ++k) {
+    for (int k = 1; k < num_touched; ++k) {
       const int t = touched[k];
-      if (t <= source) continue;
       const int slot = band_start[touched_band[k]]++;
       row_vertex[slot] = t;
       row_dist2[slot] = label[t].dist * label[t].dist;
     }
     ws.row_offsets[source + 1] = static_cast<int>(ws.row_vertex.size());
-    num_previous = num_touched;
-    for (int k = 0; k < num_touched; ++k) {
-      previous_vertex[k] = touched[k];
-      previous_dist[k] = label[touched[k]].dist;
-    }
   }
 }
 

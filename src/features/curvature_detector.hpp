@@ -147,8 +147,9 @@ struct CurvatureWorkspace {
   std::vector<int> row_offsets, row_vertex, row_scale_count;
   std::vector<double> row_dist2;
   std::vector<GeodesicLabel> labels;
-  std::vector<int> queue, touched, touched_band, previous_vertex;
-  std::vector<double> previous_dist;
+  std::vector<int> queue, touched, touched_band;
+  std::vector<double> dist_ahead;
+  std::vector<std::pair<int, int>> crossing_edges;
   // Smoothing.
   std::vector<double> kernel, density, inv_density, sum_w, sum_wx, sum_wy;
 };
