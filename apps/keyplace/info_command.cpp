@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <fmt/core.h>
@@ -10,6 +13,8 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/store/map_file.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -100,10 +105,81 @@ void PrintLog(const nlohmann::json& json) {
   }
 }
 
+bool IsSqliteFile(const std::string& path) {
+  char header[16] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(header, sizeof(header));
+  return in.gcount() == sizeof(header) && std::memcmp(header, "SQLite format 3", 16) == 0;
+}
+
+nlohmann::json DescribeMap(const std::string& path, const GlobalMap& map) {
+  const MappingStats stats = ComputeStats(map);
+  nlohmann::json json;
+  json["file"] = path;
+  json["file_bytes"] = std::filesystem::file_size(path);
+  json["source_log"] = map.source_log;
+  json["source_hash"] = map.source_hash;
+  json["pose_source"] = map.pose_source;
+  json["source_scans"] = map.source_scans;
+  json["submaps"] = stats.submaps;
+  json["forced_submaps"] = stats.forced_submaps;
+  json["stable_keypoints"] = stats.stable_keypoints;
+  json["source_keypoints"] = stats.source_keypoints;
+  json["compression"] = stats.compression;
+  json["scans_per_submap"] = stats.scans_per_submap;
+  json["keypoints_per_submap"] = stats.keypoints_per_submap;
+  json["distribution"] = stats.distribution;
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  bool first = true;
+  for (const auto& submap : map.submaps) {
+    for (const auto& pose : submap.poses) {
+      min_x = first ? pose.x : std::min(min_x, pose.x);
+      min_y = first ? pose.y : std::min(min_y, pose.y);
+      max_x = first ? pose.x : std::max(max_x, pose.x);
+      max_y = first ? pose.y : std::max(max_y, pose.y);
+      first = false;
+    }
+  }
+  json["trajectory_extent_m"] = {max_x - min_x, max_y - min_y};
+  nlohmann::json config;
+  for (const auto& [key, value] : ToKeyValues(map.config)) config[key] = value;
+  json["config"] = config;
+  return json;
+}
+
+void PrintMap(const nlohmann::json& json) {
+  fmt::print("map file             {} ({:.1f} KiB)\n", json["file"].get<std::string>(),
+             json["file_bytes"].get<double>() / 1024.0);
+  fmt::print("built from           {} ({}, {} poses, {} scans)\n",
+             json["source_log"].get<std::string>(), json["source_hash"].get<std::string>(),
+             json["pose_source"].get<std::string>(), json["source_scans"].get<std::size_t>());
+  fmt::print("submaps              {} ({} closed by the scan limit)\n",
+             json["submaps"].get<std::size_t>(), json["forced_submaps"].get<std::size_t>());
+  fmt::print("stable keypoints     {} of {} ({:.3f}, {:.1f} % less map data)\n",
+             json["stable_keypoints"].get<std::size_t>(),
+             json["source_keypoints"].get<std::size_t>(), json["compression"].get<double>(),
+             100.0 * (1.0 - json["compression"].get<double>()));
+  fmt::print("scans per submap     {:.2f}\n", json["scans_per_submap"].get<double>());
+  fmt::print("keypoints per submap {:.2f}\n", json["keypoints_per_submap"].get<double>());
+  fmt::print("distribution         {:.3f}\n", json["distribution"].get<double>());
+  fmt::print("trajectory extent    {:.1f} m x {:.1f} m\n",
+             json["trajectory_extent_m"][0].get<double>(),
+             json["trajectory_extent_m"][1].get<double>());
+  fmt::print("parameters\n");
+  for (const auto& [key, value] : json["config"].items()) {
+    fmt::print("  {:<27}{}\n", key, value.get<std::string>());
+  }
+}
+
 void RunInfo(const InfoOptions& options) {
-  const CarmenLog log = ReadLogWithScans(options.input);
-  const nlohmann::json json = DescribeLog(log);
-  PrintLog(json);
+  nlohmann::json json;
+  if (IsSqliteFile(options.input)) {
+    json = DescribeMap(options.input, LoadMap(options.input));
+    PrintMap(json);
+  } else {
+    json = DescribeLog(ReadLogWithScans(options.input));
+    PrintLog(json);
+  }
   if (!options.json_path.empty()) WriteJson(options.json_path, json);
 }
 

@@ -1,6 +1,6 @@
 #include "keyplace/mapping/mapping_config.hpp"
 
-#include <cstdio>
+#include <charconv>
 #include <stdexcept>
 #include <string>
 
@@ -31,10 +31,11 @@ void Validate(const MappingConfig& config) {
 namespace keyplace {
 namespace {
 
+// The shortest text that reads back as the same double.
 std::string FormatDouble(double value) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.17g", value);
-  return text;
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return std::string(text, result.ptr);
 }
 
 double ParseDouble(const std::string& key, const std::string& text) {
