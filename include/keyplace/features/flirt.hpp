@@ -62,7 +62,8 @@ struct FlirtSignals {
 };
 
 /// FLIRT detector + beta-grid descriptor. Immutable after construction; all methods are const
-/// and thread-safe: scratch buffers live in a per-thread workspace that is reused between calls.
+/// and thread-safe: scratch buffers live in a per-thread workspace that is reused between calls
+/// (about 8 n^2 bytes for n valid beams, e.g. 1 MB for 360 beams).
 class FlirtExtractor {
  public:
   explicit FlirtExtractor(FlirtConfig config = {});
@@ -73,8 +74,11 @@ class FlirtExtractor {
 
   /// Detects and describes the keypoints of one scan, in FLIRTLib's order (scale level
   /// ascending, then beam order). Positions and orientations are in the laser frame.
-  /// `T_world_laser` only orients FLIRTLib's axis-aligned duplicate-suppression box (the
-  /// original works on world-frame points); pass the laser pose to reproduce FLIRTLib exactly.
+  /// `T_world_laser` is the frame the detector computes in, as FLIRTLib detects on world-frame
+  /// points: it orients FLIRTLib's axis-aligned duplicate-suppression box, and the rounding of
+  /// the world coordinates decides between near-equal edge lengths in the spanning trees. Any
+  /// pose gives valid keypoints; pass the laser pose (as printed in the log) to reproduce
+  /// FLIRTLib's output exactly.
   /// A beam is used when its range is finite, >= 0 and < scan.max_range_m. Scans with fewer than
   /// 5 such beams give no keypoints. Throws std::invalid_argument when ranges_m and angles_rad
   /// differ in size.
