@@ -29,10 +29,7 @@ void BeamWindow(const ScanRays& rays, double min_alpha, double max_alpha, int& b
   const std::int64_t high =
       TruncateLikeFlirtLib(rays.angle_normalizer * (max_alpha - rays.first_angle_rad));
   // minIndex = max(0, int(minIndex) - 1)
-  const std::int32_t low32 = static_cast<std::int32_t>(static_cast<std::uint32_t>(low));
-  begin = std::max<std::int64_t>(0, static_cast<std::int64_t>(low32) - 1) > n
-              ? n
-              : static_cast<int>(std::max<std::int64_t>(0, static_cast<std::int64_t>(low32) - 1));
+  begin = static_cast<int>(std::min<std::int64_t>(std::max<std::int64_t>(0, low - 1), n));
   // maxIndex = min(size, size_t(unsigned(maxIndex) + 2)) with 32-bit wrap-around.
   const std::uint32_t high32 = static_cast<std::uint32_t>(high) + 2u;
   end = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(n), high32));

@@ -243,7 +243,6 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
   ws.edge_a.pop_back();
   ws.edge_b.pop_back();
   if (!PrimRoundUniqueMinima(n, ws)) {
-    ++ws.prim_fallbacks;
     PrimRoundBoostOrder(n, ws);
   }
   const int* parent = ws.prim_parent.data();

@@ -133,7 +133,6 @@ struct CurvatureWorkspace {
   // Prim.
   std::vector<int> prim_parent, prim_vertex, prim_position, prim_key_parent;
   std::vector<double> prim_x, prim_y;
-  long prim_fallbacks = 0;  // rounds that needed the exact Boost-order emulation
   std::vector<double> prim_key2, prim_gate, prim_saved_gate;
   QuaternaryHeap<PrimKeyOrder> prim_heap;
   // Edges of the spanning-tree union (and its CSR adjacency).
@@ -143,7 +142,8 @@ struct CurvatureWorkspace {
   std::vector<int> removed_offsets, removed_targets, removed_fill;
   std::vector<int> adj_offsets, adj_targets, adj_fill;
   std::vector<AdjacentVertex> adjacent;
-  // Truncated geodesic rows: for each source, the vertices within the cutoff in settle order.
+  // Truncated geodesic rows: for each source i, the vertices j > i within the cutoff, grouped
+  // by scale band (see TruncatedGeodesicRows).
   std::vector<int> row_offsets, row_vertex, row_scale_count;
   std::vector<double> row_dist2;
   std::vector<GeodesicLabel> labels;
