@@ -60,6 +60,19 @@ import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['keypoints_per_scan_mean'] > 5 and j['seconds_per_scan_mean'] > 0" "$work/kp.json"
 
+check "map" "$keyplace" map "$log" --out "$work/map.kpm" --json "$work/map.json" --png "$work/map.png"
+check "map json keys" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+for k in ['compression','scans_per_submap','keypoints_per_submap','distribution','submaps','seconds_per_submap','seconds_total']:
+    assert k in j, k
+assert 0 < j['compression'] < 0.5 and j['submaps'] > 50" "$work/map.json"
+check "map png" test -s "$work/map.png"
+check "info on map" "$keyplace" info "$work/map.kpm" --json "$work/mapinfo.json"
+check "info map submaps" test "$(json_value "$work/mapinfo.json" submaps)" = "$(json_value "$work/map.json" submaps)"
+printf 'SQLite format 3\0garbage' >"$work/bad.kpm"
+fails_with "corrupt map" "bad.kpm" "$keyplace" info "$work/bad.kpm"
+
 printf 'not a log\n' >"$work/text.log"
 fails_with "non-log input" "no laser scans" "$keyplace" info "$work/text.log"
 printf 'FLASER 3 1.0 2.0 0 0 0 0 0 0 1 h 1\n' >"$work/bad.log"
