@@ -1,0 +1,85 @@
+#pragma once
+// Parameters of place recognition (paper Section 4, defaults from Table V and Section 5.2).
+// Every reading of an ambiguity in the paper is a field here; docs/PLACE.md explains each one.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace keyplace {
+
+struct PlaceRecognitionConfig {
+  // --- submap matching (Algorithm 3)
+  int min_pairs = 10;                  // mu: unique descriptor pairs for a candidate
+  int max_candidates = 500;            // n_c: candidates verified, by increasing mean pair distance
+  double descriptor_match_chi2 = 0.4;  // a descriptor pair: symmetric chi2 below this
+  // How "FindUniqueMatch" pairs keypoints, each used at most once. kQueryOrder: every query
+  // keypoint in turn takes its nearest still-unused reference keypoint (Algorithm 3 read
+  // literally). kGlobalGreedy: all pairs below the threshold by increasing distance.
+  enum class PairMatching { kQueryOrder, kGlobalGreedy };
+  PairMatching pair_matching = PairMatching::kGlobalGreedy;
+
+  // --- RANSAC (Section 4.1.1; FLIRTLib's RansacFeatureSetMatcher)
+  double inlier_distance_m = 0.1;  // acceptance: a transformed query keypoint within this of its
+                                   // geometric nearest reference keypoint is an inlier
+  int ransac_iterations = 18;      // random 2-pair hypotheses (FLIRTLib: p = 0.95, w = 0.4 -> 18)
+  // Enumerate every pair of descriptor pairs instead of sampling when there are at most this many
+  // descriptor pairs (n (n-1) / 2 hypotheses); 0 = always sample.
+  int exhaustive_hypotheses_max_pairs = 40;
+  double rigidity_m2 = 0.0064;  // FLIRTLib's rigidity pre-check of a hypothesis (squared metres)
+  bool refine = true;           // least-squares refit on the inliers (FLIRTLib does)
+  std::uint64_t seed = 1;       // RANSAC seed, combined with the place id
+
+  // --- geometric verification (Section 4.2)
+  int min_consensus = 9;         // first check: RANSAC inliers
+  double min_gamma = 0.4;        // gamma_min: second check, Eq. (10)
+  double double_match_m = 0.05;  // lambda: max distance of a doubly matched pair
+  // How n_dm counts doubly matched keypoints. kUniquePairs: pairs in a one-to-one matching (by
+  // increasing distance), gamma = 2 n_pairs / (n_r + n_c). kPerKeypoint: every keypoint of either
+  // side with some double match counts half, gamma = (n_dm_r + n_dm_c) / (n_r + n_c).
+  enum class GammaCounting { kUniquePairs, kPerKeypoint };
+  GammaCounting gamma_counting = GammaCounting::kUniquePairs;
+
+  // --- which verified candidate answers
+  // kFirstVerified: the first candidate (in mean-distance order) that passes both checks (the
+  // paper). kBestScore: verify all n_c candidates and answer the one with the highest score.
+  enum class Selection { kFirstVerified, kBestScore };
+  Selection selection = Selection::kBestScore;
+  // The score of a verified candidate: kGamma, kConsensus, or kConsensusGamma = consensus * gamma.
+  enum class Score { kGamma, kConsensus, kConsensusGamma };
+  Score score = Score::kConsensusGamma;
+
+  // --- confidence and ambiguity (beyond the paper)
+  // Two verified candidates are distinct when their estimated poses differ by more than these.
+  double distinct_distance_m = 1.0;
+  double distinct_angle_deg = 20.0;
+  // The answer is ambiguous when a distinct verified candidate scores at least this fraction of
+  // the best score (1 or more = never ambiguous).
+  double ambiguity_ratio = 0.8;
+  // Answers below this confidence are not accepted (confidence in [0, 1], see PlaceMatch).
+  double min_confidence = 0.0;
+  // Consensus at which the consensus factor of the confidence saturates.
+  int confidence_consensus = 20;
+};
+
+/// The paper's method as closely as we can: Algorithm 3 pairing in query order, 18 sampled
+/// hypotheses (FLIRTLib), first verified candidate wins, no ambiguity rejection.
+PlaceRecognitionConfig PaperPlaceConfig();
+
+/// "default" | "paper"; throws std::invalid_argument naming the accepted values.
+PlaceRecognitionConfig PlacePreset(const std::string& name);
+
+/// Throws std::invalid_argument naming the first invalid field.
+void Validate(const PlaceRecognitionConfig& config);
+
+/// Every field as (name, text value), in declaration order; enums as lower-case names.
+std::vector<std::pair<std::string, std::string>> ToKeyValues(const PlaceRecognitionConfig& config);
+
+/// Sets the named fields from text. Throws std::invalid_argument naming the key for an unknown
+/// key or a value that does not parse. The result is validated.
+void ApplyKeyValues(const std::map<std::string, std::string>& values,
+                    PlaceRecognitionConfig& config);
+
+}  // namespace keyplace

@@ -1,0 +1,129 @@
+#pragma once
+// Place recognition (paper Section 4): submap matching by unique descriptor pairs (Algorithm 3),
+// RANSAC pose estimation (Eq. 9), first (consensus) and second (gamma, Eq. 10) geometric
+// verification. A "place" is a set of keypoints in its own frame with the world pose of that
+// frame: a submap of a GlobalMap, or a single scan (the TIP-FLIRT baseline), on the same code.
+// Matching is exhaustive over all places: the oracle for any faster index.
+
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/descriptor.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/place/place_config.hpp"
+
+namespace keyplace {
+
+struct Place {
+  int id = 0;                                   // submap id (or scan index for single-scan places)
+  Pose2 T_world_place;                          // P_r[0]: the world pose of the place's frame
+  std::vector<Eigen::Vector2d> positions;       // keypoints, place frame
+  std::vector<BetaGridDescriptor> descriptors;  // same order
+  std::vector<int> scan_indices;                // scans the place was built from
+};
+
+/// One place per submap, in map order (keypoints in the submap frame, T_world_place = P[0]).
+std::vector<Place> PlacesFromMap(const GlobalMap& map);
+
+/// The keypoints of the current submap S_c in its own frame (P_c[0]) and p_c: the pose to
+/// estimate, relative to P_c[0] (its last scan in the paper).
+struct PlaceQuery {
+  std::vector<Eigen::Vector2d> positions;
+  std::vector<BetaGridDescriptor> descriptors;
+  Pose2 T_first_evaluated;
+};
+
+/// A descriptor pair of Algorithm 3: (query keypoint, place keypoint, symmetric chi2).
+struct DescriptorPair {
+  int current = 0;
+  int reference = 0;
+  double distance = 0.0;
+};
+
+/// Unique descriptor pairs below `chi2_threshold` (each keypoint used at most once).
+std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescriptor>& current,
+                                                 const std::vector<BetaGridDescriptor>& reference,
+                                                 double chi2_threshold,
+                                                 PlaceRecognitionConfig::PairMatching mode);
+
+/// The second geometric verification, Eq. (10), with the current keypoints mapped by T_ref_cur
+/// into the reference frame. The overlap area is the intersection of the two axis-aligned
+/// bounding boxes (reference frame) of the keypoints; n_r, n_c count the keypoints inside it.
+struct GammaResult {
+  double gamma = 0.0;  // 0 when the overlap holds no keypoint
+  int reference_in_overlap = 0;
+  int current_in_overlap = 0;
+  double double_matched = 0.0;  // n_dm (pairs, or half-counts of keypoints; see GammaCounting)
+};
+GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions,
+                         const std::vector<BetaGridDescriptor>& reference_descriptors,
+                         const std::vector<Eigen::Vector2d>& current_positions,
+                         const std::vector<BetaGridDescriptor>& current_descriptors,
+                         const Pose2& T_ref_cur, double lambda_m, double chi2_threshold,
+                         PlaceRecognitionConfig::GammaCounting counting);
+
+/// One candidate place that went through RANSAC.
+struct CandidateResult {
+  int place_index = -1;
+  int pairs = 0;
+  double mean_pair_distance = 0.0;
+  int consensus = 0;
+  double gamma = 0.0;
+  bool verified = false;  // passed both checks
+  Pose2 T_ref_cur;
+  Pose2 estimated_pose;  // Eq. (9)
+  double score = 0.0;    // selection score (PlaceRecognitionConfig::score), verified only
+};
+
+struct PlaceMatch {
+  // A candidate passed both checks (the best one is described below), before the ambiguity and
+  // confidence filters.
+  bool verified = false;
+  // The answer is accepted: verified, not ambiguous, confidence >= min_confidence.
+  bool found = false;
+  // A distinct verified candidate (pose farther than distinct_*) scored >= ambiguity_ratio * best.
+  bool ambiguous = false;
+  int place_index = -1;  // into the recognizer's places
+  int place_id = -1;
+  Pose2 T_ref_cur;       // P_c[0] in the frame of P_r[0]
+  Pose2 estimated_pose;  // p^ = P_r[0] * T_ref_cur * p_c (Eq. 9), world frame
+  int pairs = 0;
+  int consensus = 0;
+  double gamma = 0.0;
+  double score = 0.0;
+  double second_score = 0.0;  // best distinct verified candidate (0 if none)
+  // In [0, 1]: min(1, consensus / confidence_consensus) * gamma * (1 - second_score / score).
+  double confidence = 0.0;
+  int candidates = 0;           // places with >= mu pairs
+  int candidates_verified = 0;  // candidates that went through RANSAC
+  int candidates_accepted = 0;  // candidates that passed both checks
+  int places_excluded = 0;      // skipped by the exclusion predicate
+  double seconds_pairing = 0.0;
+  double seconds_verification = 0.0;
+  double seconds = 0.0;
+  std::vector<CandidateResult> verified_candidates;  // those that passed both checks
+};
+
+/// Returns true for places the query must not be matched with (self-matches).
+using PlaceExclusion = std::function<bool(const Place&)>;
+
+class PlaceRecognizer {
+ public:
+  /// Throws std::invalid_argument (Validate) for an invalid config.
+  PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config);
+
+  PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
+
+  const std::vector<Place>& places() const { return places_; }
+  const PlaceRecognitionConfig& config() const { return config_; }
+
+ private:
+  std::vector<Place> places_;
+  PlaceRecognitionConfig config_;
+};
+
+}  // namespace keyplace

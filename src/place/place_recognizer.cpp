@@ -1,0 +1,331 @@
+#include "keyplace/place/place_recognizer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "keyplace/place/ransac.hpp"
+
+namespace keyplace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct Box {
+  Eigen::Vector2d min{std::numeric_limits<double>::infinity(),
+                      std::numeric_limits<double>::infinity()};
+  Eigen::Vector2d max{-std::numeric_limits<double>::infinity(),
+                      -std::numeric_limits<double>::infinity()};
+  void Add(const Eigen::Vector2d& p) {
+    min = min.cwiseMin(p);
+    max = max.cwiseMax(p);
+  }
+  bool Contains(const Eigen::Vector2d& p) const {
+    return p.x() >= min.x() && p.x() <= max.x() && p.y() >= min.y() && p.y() <= max.y();
+  }
+};
+
+double SelectionScore(PlaceRecognitionConfig::Score score, int consensus, double gamma) {
+  switch (score) {
+    case PlaceRecognitionConfig::Score::kGamma:
+      return gamma;
+    case PlaceRecognitionConfig::Score::kConsensus:
+      return consensus;
+    case PlaceRecognitionConfig::Score::kConsensusGamma:
+      break;
+  }
+  return consensus * gamma;
+}
+
+// Mixes the RANSAC seed with the place id so that each place's hypotheses do not depend on the
+// order in which candidates are verified.
+std::uint64_t PlaceSeed(std::uint64_t seed, int place_id) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(place_id) + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::vector<Place> PlacesFromMap(const GlobalMap& map) {
+  std::vector<Place> places;
+  places.reserve(map.submaps.size());
+  for (const Submap& submap : map.submaps) {
+    Place place;
+    place.id = submap.id;
+    place.T_world_place = submap.poses.empty() ? Pose2{} : submap.origin();
+    for (const StableKeypoint& keypoint : submap.keypoints) {
+      place.positions.push_back(keypoint.position_m);
+      place.descriptors.push_back(keypoint.descriptor);
+    }
+    place.scan_indices = submap.scan_indices;
+    places.push_back(std::move(place));
+  }
+  return places;
+}
+
+std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescriptor>& current,
+                                                 const std::vector<BetaGridDescriptor>& reference,
+                                                 double chi2_threshold,
+                                                 PlaceRecognitionConfig::PairMatching mode) {
+  // Every pair below the threshold, with its distance.
+  std::vector<DescriptorPair> below;
+  for (std::size_t c = 0; c < current.size(); ++c) {
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+      if (SymmetricChi2Below(current[c], reference[r], chi2_threshold)) {
+        below.push_back(
+            {static_cast<int>(c), static_cast<int>(r), SymmetricChi2(current[c], reference[r])});
+      }
+    }
+  }
+  if (mode == PlaceRecognitionConfig::PairMatching::kGlobalGreedy) {
+    std::stable_sort(
+        below.begin(), below.end(),
+        [](const DescriptorPair& a, const DescriptorPair& b) { return a.distance < b.distance; });
+  }
+  // kQueryOrder: `below` is ordered by current keypoint; each takes its nearest unused reference.
+  std::vector<char> current_used(current.size(), 0);
+  std::vector<char> reference_used(reference.size(), 0);
+  std::vector<DescriptorPair> pairs;
+  if (mode == PlaceRecognitionConfig::PairMatching::kGlobalGreedy) {
+    for (const DescriptorPair& pair : below) {
+      if (current_used[pair.current] || reference_used[pair.reference]) continue;
+      current_used[pair.current] = 1;
+      reference_used[pair.reference] = 1;
+      pairs.push_back(pair);
+    }
+    return pairs;
+  }
+  std::size_t begin = 0;
+  while (begin < below.size()) {
+    std::size_t end = begin;
+    const DescriptorPair* best = nullptr;
+    while (end < below.size() && below[end].current == below[begin].current) {
+      const DescriptorPair& pair = below[end];
+      if (!reference_used[pair.reference] && (!best || pair.distance < best->distance)) {
+        best = &pair;
+      }
+      ++end;
+    }
+    if (best) {
+      reference_used[best->reference] = 1;
+      pairs.push_back(*best);
+    }
+    begin = end;
+  }
+  return pairs;
+}
+
+GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions,
+                         const std::vector<BetaGridDescriptor>& reference_descriptors,
+                         const std::vector<Eigen::Vector2d>& current_positions,
+                         const std::vector<BetaGridDescriptor>& current_descriptors,
+                         const Pose2& T_ref_cur, double lambda_m, double chi2_threshold,
+                         PlaceRecognitionConfig::GammaCounting counting) {
+  GammaResult result;
+  std::vector<Eigen::Vector2d> current_in_ref;
+  current_in_ref.reserve(current_positions.size());
+  Box reference_box;
+  Box current_box;
+  for (const auto& p : reference_positions) reference_box.Add(p);
+  for (const auto& p : current_positions) {
+    current_in_ref.push_back(T_ref_cur * p);
+    current_box.Add(current_in_ref.back());
+  }
+  Box overlap;
+  overlap.min = reference_box.min.cwiseMax(current_box.min);
+  overlap.max = reference_box.max.cwiseMin(current_box.max);
+  if (overlap.min.x() > overlap.max.x() || overlap.min.y() > overlap.max.y()) return result;
+
+  std::vector<int> reference_inside;
+  std::vector<int> current_inside;
+  for (std::size_t r = 0; r < reference_positions.size(); ++r) {
+    if (overlap.Contains(reference_positions[r])) reference_inside.push_back(static_cast<int>(r));
+  }
+  for (std::size_t c = 0; c < current_in_ref.size(); ++c) {
+    if (overlap.Contains(current_in_ref[c])) current_inside.push_back(static_cast<int>(c));
+  }
+  result.reference_in_overlap = static_cast<int>(reference_inside.size());
+  result.current_in_overlap = static_cast<int>(current_inside.size());
+  const int total = result.reference_in_overlap + result.current_in_overlap;
+  if (total == 0) return result;
+
+  // Doubly matched: within lambda and descriptors within the chi2 threshold.
+  const double lambda2 = lambda_m * lambda_m;
+  std::vector<std::tuple<double, int, int>> doubles;  // (distance^2, current, reference)
+  for (int c : current_inside) {
+    for (int r : reference_inside) {
+      const double d2 = (current_in_ref[c] - reference_positions[r]).squaredNorm();
+      if (d2 <= lambda2 &&
+          SymmetricChi2Below(current_descriptors[c], reference_descriptors[r], chi2_threshold)) {
+        doubles.emplace_back(d2, c, r);
+      }
+    }
+  }
+  if (counting == PlaceRecognitionConfig::GammaCounting::kUniquePairs) {
+    std::sort(doubles.begin(), doubles.end());
+    std::vector<char> current_used(current_positions.size(), 0);
+    std::vector<char> reference_used(reference_positions.size(), 0);
+    int matched = 0;
+    for (const auto& [d2, c, r] : doubles) {
+      if (current_used[c] || reference_used[r]) continue;
+      current_used[c] = 1;
+      reference_used[r] = 1;
+      ++matched;
+    }
+    result.double_matched = matched;
+  } else {
+    std::vector<char> current_hit(current_positions.size(), 0);
+    std::vector<char> reference_hit(reference_positions.size(), 0);
+    for (const auto& [d2, c, r] : doubles) {
+      current_hit[c] = 1;
+      reference_hit[r] = 1;
+    }
+    int hits = 0;
+    for (char h : current_hit) hits += h;
+    for (char h : reference_hit) hits += h;
+    result.double_matched = 0.5 * hits;
+  }
+  result.gamma = 2.0 * result.double_matched / static_cast<double>(total);
+  return result;
+}
+
+PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config)
+    : places_(std::move(places)), config_(config) {
+  Validate(config_);
+  for (const Place& place : places_) {
+    if (place.positions.size() != place.descriptors.size()) {
+      throw std::invalid_argument("Place " + std::to_string(place.id) +
+                                  ": positions and descriptors differ in size");
+    }
+  }
+}
+
+PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
+                                      const PlaceExclusion& exclude) const {
+  const auto start = Clock::now();
+  PlaceMatch match;
+  if (query.positions.size() != query.descriptors.size()) {
+    throw std::invalid_argument("PlaceQuery: positions and descriptors differ in size");
+  }
+  const std::size_t min_pairs = static_cast<std::size_t>(config_.min_pairs);
+
+  // Algorithm 3 against every place: candidates with >= mu unique pairs.
+  struct Candidate {
+    int place_index;
+    double mean_distance;
+    std::vector<DescriptorPair> pairs;
+  };
+  std::vector<Candidate> candidates;
+  if (query.positions.size() >= min_pairs) {
+    for (std::size_t p = 0; p < places_.size(); ++p) {
+      const Place& place = places_[p];
+      if (place.positions.size() < min_pairs) continue;  // can never reach mu pairs
+      if (exclude && exclude(place)) {
+        ++match.places_excluded;
+        continue;
+      }
+      std::vector<DescriptorPair> pairs =
+          MatchDescriptorPairs(query.descriptors, place.descriptors, config_.descriptor_match_chi2,
+                               config_.pair_matching);
+      if (pairs.size() < min_pairs) continue;
+      double sum = 0.0;
+      for (const DescriptorPair& pair : pairs) sum += pair.distance;
+      candidates.push_back(
+          {static_cast<int>(p), sum / static_cast<double>(pairs.size()), std::move(pairs)});
+    }
+  }
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const Candidate& a, const Candidate& b) { return a.mean_distance < b.mean_distance; });
+  match.candidates = static_cast<int>(candidates.size());
+  match.seconds_pairing = SecondsSince(start);
+
+  // Geometric verification of the first n_c candidates.
+  const auto verify_start = Clock::now();
+  RansacConfig ransac;
+  ransac.inlier_distance_m = config_.inlier_distance_m;
+  ransac.iterations = config_.ransac_iterations;
+  ransac.exhaustive_max_pairs = config_.exhaustive_hypotheses_max_pairs;
+  ransac.rigidity_m2 = config_.rigidity_m2;
+  ransac.refine = config_.refine;
+  const std::size_t to_verify =
+      std::min(candidates.size(), static_cast<std::size_t>(config_.max_candidates));
+  std::vector<std::pair<int, int>> index_pairs;
+  for (std::size_t k = 0; k < to_verify; ++k) {
+    const Candidate& candidate = candidates[k];
+    const Place& place = places_[candidate.place_index];
+    ++match.candidates_verified;
+    index_pairs.clear();
+    for (const DescriptorPair& pair : candidate.pairs) {
+      index_pairs.emplace_back(pair.current, pair.reference);
+    }
+    ransac.seed = PlaceSeed(config_.seed, place.id);
+    const RansacResult estimate =
+        EstimateRigidTransformRansac(place.positions, query.positions, index_pairs, ransac);
+    if (!estimate.valid) continue;
+    const int consensus = static_cast<int>(estimate.inliers.size());
+    if (consensus < config_.min_consensus) continue;  // first check
+    const GammaResult gamma = ComputeGamma(
+        place.positions, place.descriptors, query.positions, query.descriptors, estimate.T_ref_cur,
+        config_.double_match_m, config_.descriptor_match_chi2, config_.gamma_counting);
+    if (gamma.gamma < config_.min_gamma) continue;  // second check
+    CandidateResult result;
+    result.place_index = candidate.place_index;
+    result.pairs = static_cast<int>(candidate.pairs.size());
+    result.mean_pair_distance = candidate.mean_distance;
+    result.consensus = consensus;
+    result.gamma = gamma.gamma;
+    result.verified = true;
+    result.T_ref_cur = estimate.T_ref_cur;
+    result.estimated_pose = place.T_world_place * estimate.T_ref_cur * query.T_first_evaluated;
+    result.score = SelectionScore(config_.score, consensus, gamma.gamma);
+    match.verified_candidates.push_back(result);
+    if (config_.selection == PlaceRecognitionConfig::Selection::kFirstVerified) break;
+  }
+  match.candidates_accepted = static_cast<int>(match.verified_candidates.size());
+  match.seconds_verification = SecondsSince(verify_start);
+
+  if (!match.verified_candidates.empty()) {
+    // The best score; ties keep the earlier candidate (smaller mean pair distance).
+    const CandidateResult* best = &match.verified_candidates.front();
+    for (const CandidateResult& candidate : match.verified_candidates) {
+      if (candidate.score > best->score) best = &candidate;
+    }
+    const double distinct_angle = config_.distinct_angle_deg * M_PI / 180.0;
+    double second = 0.0;
+    for (const CandidateResult& candidate : match.verified_candidates) {
+      const Pose2 delta = Between(best->estimated_pose, candidate.estimated_pose);
+      const bool distinct = TranslationNorm(delta) > config_.distinct_distance_m ||
+                            std::abs(delta.theta) > distinct_angle;
+      if (distinct) second = std::max(second, candidate.score);
+    }
+    match.verified = true;
+    match.place_index = best->place_index;
+    match.place_id = places_[best->place_index].id;
+    match.T_ref_cur = best->T_ref_cur;
+    match.estimated_pose = best->estimated_pose;
+    match.pairs = best->pairs;
+    match.consensus = best->consensus;
+    match.gamma = best->gamma;
+    match.score = best->score;
+    match.second_score = second;
+    const double consensus_factor =
+        std::min(1.0, static_cast<double>(best->consensus) / config_.confidence_consensus);
+    const double gap = best->score > 0.0 ? std::max(0.0, 1.0 - second / best->score) : 0.0;
+    match.confidence = consensus_factor * best->gamma * gap;
+    match.ambiguous = second > 0.0 && second >= config_.ambiguity_ratio * best->score;
+    match.found = !match.ambiguous && match.confidence >= config_.min_confidence;
+  }
+  match.seconds = SecondsSince(start);
+  return match;
+}
+
+}  // namespace keyplace

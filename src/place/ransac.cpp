@@ -1,0 +1,148 @@
+#include "keyplace/place/ransac.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace keyplace {
+namespace {
+
+// The transform mapping segment (c1, c2) of the current set onto (r1, r2) of the reference set
+// (rotation from the segment directions, translation from the second point, as FLIRTLib).
+Pose2 HypothesisFromTwoPairs(const Eigen::Vector2d& c1, const Eigen::Vector2d& c2,
+                             const Eigen::Vector2d& r1, const Eigen::Vector2d& r2) {
+  const Eigen::Vector2d base = c1 - c2;
+  const Eigen::Vector2d moved = r1 - r2;
+  const double angle = std::atan2(base.x() * moved.y() - base.y() * moved.x(), base.dot(moved));
+  const double c = std::cos(angle);
+  const double s = std::sin(angle);
+  const Eigen::Vector2d rotated(c * c2.x() - s * c2.y(), s * c2.x() + c * c2.y());
+  return {r2.x() - rotated.x(), r2.y() - rotated.y(), angle};
+}
+
+}  // namespace
+
+Pose2 FitRigidTransform(const std::vector<Eigen::Vector2d>& reference,
+                        const std::vector<Eigen::Vector2d>& current) {
+  const std::size_t n = std::min(reference.size(), current.size());
+  if (n < 2) return {};
+  Eigen::Vector2d mean_ref = Eigen::Vector2d::Zero();
+  Eigen::Vector2d mean_cur = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    mean_ref += reference[i];
+    mean_cur += current[i];
+  }
+  mean_ref /= static_cast<double>(n);
+  mean_cur /= static_cast<double>(n);
+  double sum_cos = 0.0;
+  double sum_sin = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d a = current[i] - mean_cur;
+    const Eigen::Vector2d b = reference[i] - mean_ref;
+    sum_cos += a.dot(b);
+    sum_sin += a.x() * b.y() - a.y() * b.x();
+  }
+  const double angle = std::atan2(sum_sin, sum_cos);
+  const double c = std::cos(angle);
+  const double s = std::sin(angle);
+  const Eigen::Vector2d rotated(c * mean_cur.x() - s * mean_cur.y(),
+                                s * mean_cur.x() + c * mean_cur.y());
+  return {mean_ref.x() - rotated.x(), mean_ref.y() - rotated.y(), angle};
+}
+
+double ScoreTransform(const std::vector<Eigen::Vector2d>& reference,
+                      const std::vector<Eigen::Vector2d>& current, const Pose2& T_ref_cur,
+                      double inlier_distance_m, std::vector<std::pair<int, int>>* inliers) {
+  if (inliers) inliers->clear();
+  if (current.empty()) return 0.0;
+  const double threshold2 = inlier_distance_m * inlier_distance_m;
+  double score = 0.0;
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    const Eigen::Vector2d point = T_ref_cur * current[i];
+    double best = std::numeric_limits<double>::infinity();
+    int best_index = -1;
+    for (std::size_t j = 0; j < reference.size(); ++j) {
+      const double d2 = (point - reference[j]).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        best_index = static_cast<int>(j);
+      }
+    }
+    if (best < threshold2) {
+      if (inliers) inliers->emplace_back(static_cast<int>(i), best_index);
+      score += best;
+    } else {
+      score += threshold2;
+    }
+  }
+  return score / static_cast<double>(current.size());
+}
+
+RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& reference,
+                                          const std::vector<Eigen::Vector2d>& current,
+                                          const std::vector<std::pair<int, int>>& pairs,
+                                          const RansacConfig& config) {
+  RansacResult result;
+  result.score = std::numeric_limits<double>::infinity();
+  const int n = static_cast<int>(pairs.size());
+  if (n < 2) return result;
+
+  std::vector<std::pair<int, int>> inliers;
+  auto try_hypothesis = [&](int a, int b) {
+    const Eigen::Vector2d& c1 = current[pairs[a].first];
+    const Eigen::Vector2d& c2 = current[pairs[b].first];
+    const Eigen::Vector2d& r1 = reference[pairs[a].second];
+    const Eigen::Vector2d& r2 = reference[pairs[b].second];
+    const double d_cur = (c1 - c2).squaredNorm();
+    const double d_ref = (r1 - r2).squaredNorm();
+    if (d_cur <= 0.0 || d_ref <= 0.0) return;
+    if ((d_cur - d_ref) * (d_cur - d_ref) / (8.0 * (d_cur + d_ref)) > config.rigidity_m2) return;
+    const Pose2 hypothesis = HypothesisFromTwoPairs(c1, c2, r1, r2);
+    ++result.hypotheses;
+    const double score =
+        ScoreTransform(reference, current, hypothesis, config.inlier_distance_m, &inliers);
+    if (score < result.score) {
+      result.score = score;
+      result.T_ref_cur = hypothesis;
+      result.inliers = inliers;
+      result.valid = true;
+    }
+  };
+
+  if (config.exhaustive_max_pairs > 0 && n <= config.exhaustive_max_pairs) {
+    for (int a = 0; a < n; ++a) {
+      for (int b = a + 1; b < n; ++b) try_hypothesis(a, b);
+    }
+  } else {
+    std::seed_seq seed_sequence{static_cast<std::uint32_t>(config.seed),
+                                static_cast<std::uint32_t>(config.seed >> 32)};
+    std::mt19937_64 rng(seed_sequence);
+    std::uniform_int_distribution<int> pick(0, n - 1);
+    for (int iteration = 0; iteration < config.iterations; ++iteration) {
+      const int a = pick(rng);
+      int b = pick(rng);
+      while (b == a) b = pick(rng);
+      try_hypothesis(a, b);
+    }
+  }
+
+  if (result.valid && config.refine && result.inliers.size() >= 2) {
+    std::vector<Eigen::Vector2d> ref_points;
+    std::vector<Eigen::Vector2d> cur_points;
+    for (const auto& [c, r] : result.inliers) {
+      cur_points.push_back(current[c]);
+      ref_points.push_back(reference[r]);
+    }
+    const Pose2 refined = FitRigidTransform(ref_points, cur_points);
+    const double score =
+        ScoreTransform(reference, current, refined, config.inlier_distance_m, &inliers);
+    if (score <= result.score) {
+      result.score = score;
+      result.T_ref_cur = refined;
+      result.inliers = inliers;
+    }
+  }
+  return result;
+}
+
+}  // namespace keyplace

@@ -1,0 +1,245 @@
+// Place recognition on synthetic maps where the right place and transform are known; gamma by
+// hand; descriptor pairing; self-match exclusion.
+
+#include "keyplace/place/place_recognizer.hpp"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/eval/localization.hpp"
+
+namespace keyplace {
+namespace {
+
+// A descriptor with its mass in 3 bins chosen by `code`: two different codes share no bin (when
+// their bins differ), so their symmetric chi2 is 1; equal codes give 0.
+BetaGridDescriptor Descriptor(int code) {
+  BetaGridDescriptor d{};
+  d[(code * 3) % kBetaGridBins] += 0.5f;
+  d[(code * 3 + 1) % kBetaGridBins] += 0.3f;
+  d[(code * 3 + 2) % kBetaGridBins] += 0.2f;
+  return d;
+}
+
+// Places of `n` keypoints each, with descriptor codes 0..15 drawn at random: descriptors repeat
+// across places (aliasing), so the geometry must decide.
+std::vector<Place> MakePlaces(int count, int n, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-6.0, 6.0);
+  std::uniform_int_distribution<int> code(0, 15);
+  std::vector<Place> places;
+  for (int p = 0; p < count; ++p) {
+    Place place;
+    place.id = p;
+    place.T_world_place = Pose2(20.0 * p, 5.0 * (p % 3), 0.3 * p);
+    for (int k = 0; k < n; ++k) {
+      place.positions.emplace_back(coordinate(rng), coordinate(rng));
+      place.descriptors.push_back(Descriptor(code(rng)));
+    }
+    place.scan_indices = {10 * p, 10 * p + 1, 10 * p + 2};
+    places.push_back(place);
+  }
+  return places;
+}
+
+// The query sees place `target` from frame T_place_query (its first pose), drops the last
+// `dropped` keypoints and adds `extra` random ones.
+PlaceQuery MakeQuery(const Place& target, const Pose2& T_place_query, int dropped, int extra,
+                     std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-6.0, 6.0);
+  std::uniform_int_distribution<int> code(0, 15);
+  PlaceQuery query;
+  const Pose2 T_query_place = T_place_query.inverse();
+  for (std::size_t k = 0; k + dropped < target.positions.size(); ++k) {
+    query.positions.push_back(T_query_place * target.positions[k]);
+    query.descriptors.push_back(target.descriptors[k]);
+  }
+  for (int k = 0; k < extra; ++k) {
+    query.positions.emplace_back(coordinate(rng), coordinate(rng));
+    query.descriptors.push_back(Descriptor(code(rng)));
+  }
+  query.T_first_evaluated = Pose2(1.5, 0.2, 0.1);
+  return query;
+}
+
+TEST(PlaceRecognizer, FindsTheRightPlaceAndTransform) {
+  const std::vector<Place> places = MakePlaces(30, 25, 11);
+  for (const auto& preset : {std::string("default"), std::string("paper")}) {
+    const PlaceRecognizer recognizer(places, PlacePreset(preset));
+    for (int target = 0; target < 30; target += 7) {
+      const Pose2 T_place_query(1.0, -0.5, 0.7);
+      const PlaceQuery query = MakeQuery(places[target], T_place_query, 5, 8, 100 + target);
+      const PlaceMatch match = recognizer.Recognize(query);
+      ASSERT_TRUE(match.found) << preset << " target " << target;
+      EXPECT_EQ(match.place_id, target) << preset;
+      EXPECT_NEAR(match.T_ref_cur.x, T_place_query.x, 1e-6);
+      EXPECT_NEAR(match.T_ref_cur.y, T_place_query.y, 1e-6);
+      EXPECT_NEAR(match.T_ref_cur.theta, T_place_query.theta, 1e-6);
+      // Eq. (9): P_r[0] * T_ref_cur * p_c.
+      const Pose2 expected = places[target].T_world_place * T_place_query * query.T_first_evaluated;
+      EXPECT_TRUE(IsCorrectPose(match.estimated_pose, expected, 1e-6, 1e-6));
+      EXPECT_GE(match.consensus, 20);
+      EXPECT_GT(match.confidence, 0.0);
+    }
+  }
+}
+
+TEST(PlaceRecognizer, ExhaustiveMatchesBruteForceCandidateCount) {
+  // The candidate count equals a brute-force count of places with >= mu unique pairs.
+  const std::vector<Place> places = MakePlaces(20, 15, 5);
+  PlaceRecognitionConfig config;
+  config.min_pairs = 6;
+  const PlaceRecognizer recognizer(places, config);
+  const PlaceQuery query = MakeQuery(places[3], Pose2(0.5, 0.5, 0.1), 0, 0, 9);
+  int expected = 0;
+  for (const Place& place : places) {
+    // Unique pairs with exact-duplicate descriptors: per code, min(count in query, in place).
+    int pairs = 0;
+    for (int code = 0; code < 16; ++code) {
+      int in_query = 0;
+      int in_place = 0;
+      for (const auto& d : query.descriptors) in_query += d == Descriptor(code);
+      for (const auto& d : place.descriptors) in_place += d == Descriptor(code);
+      pairs += std::min(in_query, in_place);
+    }
+    if (pairs >= config.min_pairs) ++expected;
+  }
+  const PlaceMatch match = recognizer.Recognize(query);
+  EXPECT_EQ(match.candidates, expected);
+  EXPECT_EQ(match.place_id, 3);
+}
+
+TEST(PlaceRecognizer, NoMatchWhenNothingFits) {
+  const std::vector<Place> places = MakePlaces(10, 20, 1);
+  const PlaceRecognizer recognizer(places, PlaceRecognitionConfig{});
+  PlaceQuery query;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-6.0, 6.0);
+  for (int k = 0; k < 20; ++k) {
+    query.positions.emplace_back(coordinate(rng), coordinate(rng));
+    query.descriptors.push_back(Descriptor(k % 16));
+  }
+  const PlaceMatch match = recognizer.Recognize(query);
+  EXPECT_FALSE(match.found);
+  EXPECT_FALSE(match.verified);
+}
+
+TEST(PlaceRecognizer, SelfMatchRulesSkipPlaces) {
+  std::vector<Place> places = MakePlaces(8, 25, 21);
+  // Place 8: the same keypoints as place 2 seen from elsewhere (another pass), other scans.
+  Place copy = places[2];
+  copy.id = 8;
+  copy.T_world_place = places[2].T_world_place * Pose2(2.0, 1.0, 0.5);
+  const Pose2 T_copy_place2 = Pose2(2.0, 1.0, 0.5).inverse();
+  for (auto& p : copy.positions) p = T_copy_place2 * p;
+  copy.scan_indices = {500, 501, 502};
+  places.push_back(copy);
+  const PlaceRecognizer recognizer(places, PaperPlaceConfig());
+  const PlaceQuery query = MakeQuery(places[2], Pose2(), 0, 0, 4);
+  const std::vector<int> query_scans = {20, 21, 22};
+
+  // Without exclusion the identical place 2 (mean pair distance 0, first) wins.
+  EXPECT_EQ(recognizer.Recognize(query).place_id, 2);
+  // The paper's rule skips place 2 (same scans): the other pass is found, at the right pose.
+  const PlaceMatch paper = recognizer.Recognize(query, [&](const Place& place) {
+    return IsSelfMatch(SelfMatchRule::kSameScans, query_scans, place.scan_indices);
+  });
+  EXPECT_EQ(paper.places_excluded, 1);
+  ASSERT_TRUE(paper.found);
+  EXPECT_EQ(paper.place_id, 8);
+  const Pose2 expected = places[2].T_world_place * query.T_first_evaluated;
+  EXPECT_TRUE(IsCorrectPose(paper.estimated_pose, expected, 1e-6, 1e-6));
+
+  // A query sharing one scan with place 2 is skipped only by the shared-scan rule.
+  const std::vector<int> shifted = {22, 23, 24};
+  const PlaceMatch same = recognizer.Recognize(query, [&](const Place& place) {
+    return IsSelfMatch(SelfMatchRule::kSameScans, shifted, place.scan_indices);
+  });
+  EXPECT_EQ(same.place_id, 2);
+  const PlaceMatch shared = recognizer.Recognize(query, [&](const Place& place) {
+    return IsSelfMatch(SelfMatchRule::kSharedScan, shifted, place.scan_indices);
+  });
+  EXPECT_EQ(shared.place_id, 8);
+}
+
+TEST(SelfMatch, Rules) {
+  EXPECT_TRUE(IsSelfMatch(SelfMatchRule::kSameScans, {5, 6, 7}, {7, 6, 5}));
+  EXPECT_FALSE(IsSelfMatch(SelfMatchRule::kSameScans, {5, 6, 7}, {5, 6, 7, 8}));
+  EXPECT_TRUE(IsSelfMatch(SelfMatchRule::kSharedScan, {5, 6, 7}, {7, 8}));
+  EXPECT_FALSE(IsSelfMatch(SelfMatchRule::kSharedScan, {5, 6, 7}, {8, 9}));
+  EXPECT_FALSE(IsSelfMatch(SelfMatchRule::kNone, {5}, {5}));
+}
+
+TEST(Gamma, ByHandOnASmallCase) {
+  // Reference box [0, 3] x [-0.5, 3]; current box [-1, 1.5] x [-1, 0.5]; overlap
+  // [0, 1.5] x [-0.5, 0.5]. Inside: reference (0,0), (1,0) -> n_r = 2; current (0.02,0),
+  // (1,0.03), (0.5,0.5) -> n_c = 3. Doubly matched (lambda 0.05, same descriptor): only
+  // (0.02,0)-(0,0); (1,0.03) is near (1,0) but its descriptor differs.
+  // gamma = 2 * 1 / (2 + 3) = 0.4.
+  const std::vector<Eigen::Vector2d> reference = {{0, 0}, {1, 0}, {0, 1}, {3, 3}, {2, -0.5}};
+  const std::vector<BetaGridDescriptor> reference_d = {Descriptor(1), Descriptor(2), Descriptor(3),
+                                                       Descriptor(4), Descriptor(5)};
+  const std::vector<Eigen::Vector2d> current_ref = {
+      {0.02, 0}, {1, 0.03}, {0.5, 0.5}, {-1, -1}, {1.5, -1}};
+  const std::vector<BetaGridDescriptor> current_d = {Descriptor(1), Descriptor(7), Descriptor(3),
+                                                     Descriptor(4), Descriptor(5)};
+  // Express the current keypoints in a frame T_ref_cur away.
+  const Pose2 T_ref_cur(0.7, -2.0, 1.3);
+  std::vector<Eigen::Vector2d> current;
+  for (const auto& p : current_ref) current.push_back(T_ref_cur.inverse() * p);
+  for (auto counting : {PlaceRecognitionConfig::GammaCounting::kUniquePairs,
+                        PlaceRecognitionConfig::GammaCounting::kPerKeypoint}) {
+    const GammaResult gamma =
+        ComputeGamma(reference, reference_d, current, current_d, T_ref_cur, 0.05, 0.4, counting);
+    EXPECT_EQ(gamma.reference_in_overlap, 2);
+    EXPECT_EQ(gamma.current_in_overlap, 3);
+    EXPECT_DOUBLE_EQ(gamma.double_matched, 1.0);
+    EXPECT_NEAR(gamma.gamma, 0.4, 1e-12);
+  }
+  // lambda 0.01 loses the double match.
+  EXPECT_EQ(ComputeGamma(reference, reference_d, current, current_d, T_ref_cur, 0.01, 0.4,
+                         PlaceRecognitionConfig::GammaCounting::kUniquePairs)
+                .gamma,
+            0.0);
+}
+
+TEST(DescriptorPairs, EachKeypointUsedOnce) {
+  BetaGridDescriptor a = Descriptor(1);
+  BetaGridDescriptor a2 = a;
+  a2[3] += 0.05f;  // a2 slightly farther from a than a is from itself
+  const std::vector<BetaGridDescriptor> current = {a2, a};
+  const std::vector<BetaGridDescriptor> reference = {a};
+  // Query order: the first current keypoint (a2) takes the only reference keypoint.
+  const auto in_order = MatchDescriptorPairs(current, reference, 0.4,
+                                             PlaceRecognitionConfig::PairMatching::kQueryOrder);
+  ASSERT_EQ(in_order.size(), 1u);
+  EXPECT_EQ(in_order[0].current, 0);
+  // Global greedy: the closest pair (a, a) wins.
+  const auto greedy = MatchDescriptorPairs(current, reference, 0.4,
+                                           PlaceRecognitionConfig::PairMatching::kGlobalGreedy);
+  ASSERT_EQ(greedy.size(), 1u);
+  EXPECT_EQ(greedy[0].current, 1);
+  EXPECT_DOUBLE_EQ(greedy[0].distance, 0.0);
+}
+
+TEST(PlaceConfig, KeyValuesRoundTripAndErrorsNameTheField) {
+  PlaceRecognitionConfig config = PaperPlaceConfig();
+  std::map<std::string, std::string> values;
+  for (const auto& [key, value] : ToKeyValues(config)) values[key] = value;
+  PlaceRecognitionConfig copy;
+  ApplyKeyValues(values, copy);
+  EXPECT_EQ(ToKeyValues(copy), ToKeyValues(config));
+  try {
+    ApplyKeyValues({{"min_gamma", "2"}}, copy);
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("min_gamma"), std::string::npos);
+  }
+  EXPECT_THROW(ApplyKeyValues({{"no_such_key", "1"}}, copy), std::invalid_argument);
+  EXPECT_THROW(PlacePreset("fast"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace keyplace
