@@ -209,6 +209,7 @@ LaserScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& 
                     fields.Number(p + 5, "robot theta"));
   scan.odometry_pose = robot;  // moved to corrected_pose at the end for corrected logs
   scan.T_robot_laser = Between(robot, laser);
+  scan.logged_laser_pose = laser;
   scan.timestamp_s = fields.Number(p + 6, "ipc_timestamp");
   scan.logger_timestamp_s = fields.Number(p + 8, "logger_timestamp");
   ClassifyBeams(scan, state.log);
@@ -249,6 +250,7 @@ LaserScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderSta
                     fields.Number(p + 5, "robot theta"));
   scan.odometry_pose = robot;
   scan.T_robot_laser = Between(robot, laser);
+  scan.logged_laser_pose = laser;
   scan.timestamp_s = fields.Number(p + 11, "ipc_timestamp");
   scan.logger_timestamp_s = fields.Number(p + 13, "logger_timestamp");
   ClassifyBeams(scan, state.log);

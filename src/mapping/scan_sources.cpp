@@ -26,10 +26,7 @@ std::string ToString(PoseSource source) {
   return "?";
 }
 
-Pose2 LogLaserPose(const LaserScan& scan) {
-  const auto& robot = scan.corrected_pose ? scan.corrected_pose : scan.odometry_pose;
-  return robot ? *robot * scan.T_robot_laser : scan.T_robot_laser;
-}
+Pose2 LogLaserPose(const LaserScan& scan) { return scan.logged_laser_pose; }
 
 std::vector<Pose2> ScanPoses(const CarmenLog& log, PoseSource source,
                              const ScanOdometryConfig& icp_config,

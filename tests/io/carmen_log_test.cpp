@@ -77,6 +77,8 @@ TEST(CarmenLog, ReadsRawLogLineTypes) {
   // Laser 4 cm behind the robot along its heading (0.5 rad).
   EXPECT_NEAR(scan.T_robot_laser.x, -0.04, 1e-2);
   EXPECT_NEAR(scan.T_robot_laser.theta, 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(scan.logged_laser_pose.x, 0.96);  // as written, not recomposed
+  EXPECT_DOUBLE_EQ(scan.logged_laser_pose.y, 2.0);
   EXPECT_DOUBLE_EQ(scan.timestamp_s, 100.6);
   EXPECT_DOUBLE_EQ(scan.logger_timestamp_s, 0.6);
   // 81.9 m readings are "no return": beyond the 80 m FLASER threshold.

@@ -28,6 +28,10 @@ struct LaserScan {
   std::optional<Pose2> corrected_pose;
   // Mounting of the laser on the robot: laser pose = robot pose * T_robot_laser.
   Pose2 T_robot_laser;
+  // The laser pose exactly as the log writes it, in the log's frame (corrected or odometry).
+  // Recomposing robot pose * T_robot_laser differs from it by a few ulps, which is enough to
+  // flip near-equal edge lengths in FLIRT's spanning trees.
+  Pose2 logged_laser_pose;
 
   std::size_t line = 0;  // 1-based line number of the laser line in its file
 

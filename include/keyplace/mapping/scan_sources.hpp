@@ -36,7 +36,7 @@ std::vector<std::vector<Keypoint>> ExtractKeypoints(const CarmenLog& log,
                                                     const FlirtExtractor& extractor,
                                                     const ProgressCallback& progress = {});
 
-/// The laser pose a log writes for a scan (corrected, else odometry, else the mounting alone).
+/// The laser pose the log writes for a scan, exactly as written (LaserScan::logged_laser_pose).
 Pose2 LogLaserPose(const LaserScan& scan);
 
 }  // namespace keyplace
