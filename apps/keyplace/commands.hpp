@@ -10,5 +10,6 @@ void RegisterInfoCommand(CLI::App& app);
 void RegisterFeaturesCommand(CLI::App& app);
 void RegisterOdometryCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
+void RegisterLocalizeCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

@@ -20,6 +20,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterFeaturesCommand(app);
   keyplace::cli::RegisterOdometryCommand(app);
   keyplace::cli::RegisterMapCommand(app);
+  keyplace::cli::RegisterLocalizeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

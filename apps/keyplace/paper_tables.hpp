@@ -24,3 +24,30 @@ struct PaperMappingRow {
 const PaperMappingRow* PaperMapping(const std::string& dataset);
 
 }  // namespace keyplace::cli
+
+namespace keyplace::cli {
+
+/// A row of Tables III/IV (corrected) or VII/VIII (raw queries, ICP): global localization with
+/// mu = 10, gamma_min = 0.4.
+struct PaperLocalizationRow {
+  const char* table;
+  double precision;
+  double recall;
+  double scans;    // scans per correct localization
+  double seconds;  // time per localization
+};
+/// The row for `dataset` ("FR079", "FR101_r", ...) and lambda (0.05 or 0.1 m); nullptr when the
+/// paper has none.
+const PaperLocalizationRow* PaperLocalization(const std::string& dataset, double lambda_m);
+
+/// Table X: P_GL and P_CL for FR079 and Intel (raw queries against the corrected map).
+struct PaperPglPcl {
+  double p_gl;
+  double p_cl;
+};
+/// `method` "ours" with mu in {5, 10} and lambda in {0.05, 0.1}, or "tip-flirt" (mu, lambda
+/// ignored). `dataset` may carry the "_r" suffix. nullptr when the paper has none.
+const PaperPglPcl* PaperTableX(const std::string& dataset, const std::string& method, int mu,
+                               double lambda_m);
+
+}  // namespace keyplace::cli
