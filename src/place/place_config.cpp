@@ -129,6 +129,7 @@ const std::vector<Field>& Fields() {
       KEYPLACE_DOUBLE_FIELD(rigidity_m2),
       KEYPLACE_BOOL_FIELD(refine),
       KEYPLACE_INT_FIELD(seed),
+      KEYPLACE_INT_FIELD(verification_neighbours),
       KEYPLACE_INT_FIELD(min_consensus),
       KEYPLACE_DOUBLE_FIELD(min_gamma),
       KEYPLACE_DOUBLE_FIELD(double_match_m),
@@ -153,6 +154,7 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.selection = PlaceRecognitionConfig::Selection::kFirstVerified;
   config.score = PlaceRecognitionConfig::Score::kGamma;
   config.ambiguity_ratio = 1.0;
+  config.verification_neighbours = 0;
   return config;
 }
 
@@ -172,6 +174,7 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.exhaustive_hypotheses_max_pairs >= 0, "exhaustive_hypotheses_max_pairs",
           "must be >= 0");
   Require(config.rigidity_m2 > 0.0, "rigidity_m2", "must be positive");
+  Require(config.verification_neighbours >= 0, "verification_neighbours", "must be >= 0");
   Require(config.min_consensus >= 2, "min_consensus", "must be >= 2");
   Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");
   Require(config.double_match_m > 0.0, "double_match_m", "must be positive");

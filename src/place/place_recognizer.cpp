@@ -259,6 +259,8 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   const std::size_t to_verify =
       std::min(candidates.size(), static_cast<std::size_t>(config_.max_candidates));
   std::vector<std::pair<int, int>> index_pairs;
+  std::vector<Eigen::Vector2d> extended_positions;
+  std::vector<BetaGridDescriptor> extended_descriptors;
   for (std::size_t k = 0; k < to_verify; ++k) {
     const Candidate& candidate = candidates[k];
     const Place& place = places_[candidate.place_index];
@@ -268,14 +270,48 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
       index_pairs.emplace_back(pair.current, pair.reference);
     }
     ransac.seed = PlaceSeed(config_.seed, place.id);
+    // The reference: the candidate, then its map neighbours in its frame (pairs index the
+    // candidate's keypoints, which come first).
+    const std::vector<Eigen::Vector2d>* reference_positions = &place.positions;
+    const std::vector<BetaGridDescriptor>* reference_descriptors = &place.descriptors;
+    if (config_.verification_neighbours > 0) {
+      extended_positions = place.positions;
+      extended_descriptors = place.descriptors;
+      const double merge2 = config_.inlier_distance_m * config_.inlier_distance_m;
+      const int index = candidate.place_index;
+      const int count = static_cast<int>(places_.size());
+      for (int offset = -config_.verification_neighbours; offset <= config_.verification_neighbours;
+           ++offset) {
+        const int n = index + offset;
+        if (offset == 0 || n < 0 || n >= count) continue;
+        const Place& neighbour = places_[n];
+        if (neighbour.id != place.id + offset) continue;  // not adjacent in the map
+        if (exclude && exclude(neighbour)) continue;
+        const Pose2 T_place_neighbour = Between(place.T_world_place, neighbour.T_world_place);
+        const std::size_t own = extended_positions.size();
+        for (std::size_t q = 0; q < neighbour.positions.size(); ++q) {
+          const Eigen::Vector2d p = T_place_neighbour * neighbour.positions[q];
+          bool duplicate = false;
+          for (std::size_t j = 0; j < own && !duplicate; ++j) {
+            duplicate = (extended_positions[j] - p).squaredNorm() < merge2;
+          }
+          if (duplicate) continue;
+          extended_positions.push_back(p);
+          extended_descriptors.push_back(neighbour.descriptors[q]);
+        }
+      }
+      reference_positions = &extended_positions;
+      reference_descriptors = &extended_descriptors;
+    }
     const RansacResult estimate =
-        EstimateRigidTransformRansac(place.positions, query.positions, index_pairs, ransac);
+        EstimateRigidTransformRansac(*reference_positions, query.positions, index_pairs, ransac);
     if (!estimate.valid) continue;
     const int consensus = static_cast<int>(estimate.inliers.size());
     if (consensus < config_.min_consensus) continue;  // first check
-    const GammaResult gamma = ComputeGamma(
-        place.positions, place.descriptors, query.positions, query.descriptors, estimate.T_ref_cur,
-        config_.double_match_m, config_.descriptor_match_chi2, config_.gamma_counting);
+    const GammaResult gamma =
+        ComputeGamma(*reference_positions, *reference_descriptors, query.positions,
+                     query.descriptors, estimate.T_ref_cur, config_.double_match_m,
+                     config_.descriptor_match_chi2, config_.gamma_counting);
     if (gamma.gamma < config_.min_gamma) continue;  // second check
     CandidateResult result;
     result.place_index = candidate.place_index;

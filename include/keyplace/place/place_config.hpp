@@ -33,6 +33,12 @@ struct PlaceRecognitionConfig {
   std::uint64_t seed = 1;       // RANSAC seed, combined with the place id
 
   // --- geometric verification (Section 4.2)
+  // Beyond the paper: verify (consensus and gamma) against the candidate submap together with
+  // this many map neighbours on each side (places id - k .. id + k, mapped into the candidate's
+  // frame; neighbour keypoints within inlier_distance_m of one already present are dropped).
+  // Excluded places never contribute. Candidate ranking still uses the candidate alone. 0 = the
+  // paper.
+  int verification_neighbours = 1;
   int min_consensus = 9;         // first check: RANSAC inliers
   double min_gamma = 0.4;        // gamma_min: second check, Eq. (10)
   double double_match_m = 0.05;  // lambda: max distance of a doubly matched pair
