@@ -11,8 +11,8 @@ std::string SourceDir() { return KEYPLACE_SOURCE_DIR; }
 
 std::string SharedDir() {
   const char* env = std::getenv("KEYPLACE_SHARED");
-  const fs::path dir = env != nullptr && *env != '\0' ? fs::path(env)
-                                                      : fs::path(SourceDir()) / ".." / "shared";
+  const fs::path dir =
+      env != nullptr && *env != '\0' ? fs::path(env) : fs::path(SourceDir()) / ".." / "shared";
   if (!fs::is_directory(dir)) {
     throw std::runtime_error("shared data folder not found at '" + dir.string() +
                              "': put the project's shared/ beside the checkout or set "
