@@ -1,0 +1,67 @@
+#include "keyplace/eval/loop_overlap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <unordered_set>
+
+namespace keyplace {
+namespace {
+
+std::uint64_t Key(std::int64_t i, std::int64_t j) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
+         static_cast<std::uint32_t>(j);
+}
+
+}  // namespace
+
+double OccupancyOverlap(const OccupancySummary& reference, const OccupancySummary& current,
+                        const Pose2& T_ref_cur) {
+  if (reference.cells.empty() && current.cells.empty()) return 0.0;
+  const double l_ref = reference.cell_size_m;
+  const double l_cur = current.cell_size_m;
+  if (!(l_ref > 0.0) || (!current.cells.empty() && !(l_cur > 0.0))) {
+    throw std::invalid_argument("OccupancyOverlap: cell_size_m must be > 0");
+  }
+  std::unordered_set<std::uint64_t> a;
+  a.reserve(reference.cells.size() * 2);
+  for (const Eigen::Vector2i& c : reference.cells) a.insert(Key(c.x(), c.y()));
+  std::unordered_set<std::uint64_t> b;
+  b.reserve(current.cells.size() * 2);
+  for (const Eigen::Vector2i& c : current.cells) {
+    const Eigen::Vector2d centre((c.x() + 0.5) * l_cur, (c.y() + 0.5) * l_cur);
+    const Eigen::Vector2d p = T_ref_cur * centre;
+    b.insert(Key(static_cast<std::int64_t>(std::floor(p.x() / l_ref)),
+                 static_cast<std::int64_t>(std::floor(p.y() / l_ref))));
+  }
+  std::size_t intersection = 0;
+  for (std::uint64_t key : b) intersection += a.count(key);
+  const std::size_t union_size = a.size() + b.size() - intersection;
+  return union_size == 0 ? 0.0 : static_cast<double>(intersection) / union_size;
+}
+
+OverlapHistogram HistogramOfOverlaps(const std::vector<double>& overlaps) {
+  OverlapHistogram histogram;
+  for (double overlap : overlaps) {
+    std::size_t bin = 4;
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (overlap < OverlapHistogram::kEdges[k + 1]) {
+        bin = k;
+        break;
+      }
+    }
+    ++histogram.counts[bin];
+    ++histogram.total;
+  }
+  return histogram;
+}
+
+double LoopPrecision(const std::vector<double>& overlaps, double min_overlap) {
+  if (overlaps.empty()) return 0.0;
+  const auto correct = std::count_if(overlaps.begin(), overlaps.end(),
+                                     [&](double overlap) { return overlap >= min_overlap; });
+  return static_cast<double>(correct) / overlaps.size();
+}
+
+}  // namespace keyplace

@@ -1,0 +1,53 @@
+#include "keyplace/eval/loop_overlap.hpp"
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace keyplace {
+namespace {
+
+OccupancySummary Block(int x0, int y0, int w, int h) {
+  OccupancySummary grid;
+  grid.cell_size_m = 0.1;
+  for (int i = 0; i < w; ++i) {
+    for (int j = 0; j < h; ++j) grid.cells.emplace_back(x0 + i, y0 + j);
+  }
+  return grid;
+}
+
+TEST(OccupancyOverlap, IdentityShiftAndDisjoint) {
+  const OccupancySummary a = Block(0, 0, 10, 10);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, a, Pose2()), 1.0);
+  // Shifted by 5 cells along x: 50 common of 150 distinct cells.
+  const OccupancySummary b = Block(0, 0, 10, 10);
+  EXPECT_NEAR(OccupancyOverlap(a, b, Pose2(0.5, 0.0, 0.0)), 50.0 / 150.0, 1e-12);
+  // The same block expressed in a frame shifted by -0.5 m maps back onto a.
+  const OccupancySummary c = Block(5, 0, 10, 10);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, c, Pose2(-0.5, 0.0, 0.0)), 1.0);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, b, Pose2(5.0, 5.0, 0.0)), 0.0);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(OccupancySummary{}, OccupancySummary{}, Pose2()), 0.0);
+}
+
+TEST(OccupancyOverlap, RotationByAQuarterTurnAboutTheCentre) {
+  // A 10 x 10 block centred on the origin is its own image under a quarter turn.
+  const OccupancySummary a = Block(-5, -5, 10, 10);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, a, Pose2(0.0, 0.0, M_PI / 2)), 1.0);
+}
+
+TEST(OverlapHistogram, PaperBinsAndPrecision) {
+  const std::vector<double> overlaps{0.0, 0.05, 0.1, 0.15, 0.29, 0.3, 0.39, 0.4, 0.95, 1.0};
+  const OverlapHistogram h = HistogramOfOverlaps(overlaps);
+  EXPECT_EQ(h.total, 10u);
+  EXPECT_EQ(h.counts[0], 2u);  // [0, 10)
+  EXPECT_EQ(h.counts[1], 2u);  // [10, 20)
+  EXPECT_EQ(h.counts[2], 1u);  // [20, 30)
+  EXPECT_EQ(h.counts[3], 2u);  // [30, 40)
+  EXPECT_EQ(h.counts[4], 3u);  // [40, 100]
+  EXPECT_DOUBLE_EQ(LoopPrecision(overlaps, 0.1), 0.8);
+  EXPECT_DOUBLE_EQ(LoopPrecision(overlaps, 0.3), 0.5);
+  EXPECT_DOUBLE_EQ(LoopPrecision({}, 0.3), 0.0);
+}
+
+}  // namespace
+}  // namespace keyplace
