@@ -11,5 +11,6 @@ void RegisterFeaturesCommand(CLI::App& app);
 void RegisterOdometryCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
+void RegisterSlamCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

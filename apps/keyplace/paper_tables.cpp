@@ -107,3 +107,23 @@ const PaperPglPcl* PaperTableX(const std::string& dataset, const std::string& me
 }
 
 }  // namespace keyplace::cli
+
+namespace keyplace::cli {
+
+const PaperSlamRow* PaperSlam(const std::string& dataset) {
+  struct Entry {
+    const char* dataset;
+    PaperSlamRow row;
+  };
+  static const Entry kRows[] = {
+      {"FR079_r", {0.08, 9.17, 21.52, 0.35, 530, 0.34, 82, 13, 73.0 / 82.0, 82.0 / 82.0}},
+      {"FR101_r", {0.11, 10.71, 34.74, 0.34, 444, 0.54, 184, 12, 169.0 / 184.0, 184.0 / 184.0}},
+      {"Intel_r", {0.11, 9.56, 19.10, 0.37, 1421, 0.30, 572, 47, 503.0 / 572.0, 569.0 / 572.0}},
+  };
+  for (const Entry& entry : kRows) {
+    if (dataset == entry.dataset) return &entry.row;
+  }
+  return nullptr;
+}
+
+}  // namespace keyplace::cli

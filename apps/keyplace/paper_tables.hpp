@@ -51,3 +51,24 @@ const PaperPglPcl* PaperTableX(const std::string& dataset, const std::string& me
                                double lambda_m);
 
 }  // namespace keyplace::cli
+
+namespace keyplace::cli {
+
+/// Section 6.2.2: Table IX (mapping criteria of the SLAM-corrected raw maps) and the loop counts
+/// and precisions of the loop-closure experiment, for FR079_r, FR101_r and Intel_r.
+struct PaperSlamRow {
+  double compression;
+  double scans_per_submap;
+  double keypoints_per_submap;
+  double distribution;
+  int submaps;
+  double seconds_per_submap;
+  int loops_detected;
+  int loops_used;
+  double precision_overlap_30;  // 73/82, 169/184, 503/572
+  double precision_overlap_10;  // 82/82, 184/184, 569/572
+};
+/// nullptr for a data set the paper did not run SLAM on.
+const PaperSlamRow* PaperSlam(const std::string& dataset);
+
+}  // namespace keyplace::cli

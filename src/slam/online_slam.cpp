@@ -1,0 +1,249 @@
+#include "keyplace/slam/online_slam.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace keyplace {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void Validate(const SlamConfig& config) {
+  ValidateScanOdometryConfig(config.odometry);
+  Validate(config.mapping);
+  Validate(config.place);
+  Validate(config.graph);
+  auto fail = [](const std::string& field, const std::string& why) {
+    throw std::invalid_argument("SlamConfig." + field + ": " + why);
+  };
+  if (config.exclude_recent_submaps < 0) fail("exclude_recent_submaps", "must be >= 0");
+  if (!(config.exclude_recent_path_m >= 0.0)) fail("exclude_recent_path_m", "must be >= 0");
+  if (!(config.gate_base_m >= 0.0)) fail("gate_base_m", "must be >= 0");
+  if (!(config.gate_per_path >= 0.0)) fail("gate_per_path", "must be >= 0");
+  if (!(config.gate_base_rad >= 0.0)) fail("gate_base_rad", "must be >= 0");
+  if (!(config.gate_per_path_rad >= 0.0)) fail("gate_per_path_rad", "must be >= 0");
+  if (!(config.odometry_sigma_base_m > 0.0)) fail("odometry_sigma_base_m", "must be > 0");
+  if (!(config.odometry_sigma_per_m >= 0.0)) fail("odometry_sigma_per_m", "must be >= 0");
+  if (!(config.odometry_sigma_base_rad > 0.0)) fail("odometry_sigma_base_rad", "must be > 0");
+  if (!(config.odometry_sigma_per_rad >= 0.0)) fail("odometry_sigma_per_rad", "must be >= 0");
+  if (!(config.odometry_sigma_rad_per_m >= 0.0)) fail("odometry_sigma_rad_per_m", "must be >= 0");
+  if (!(config.loop_sigma_m > 0.0)) fail("loop_sigma_m", "must be > 0");
+  if (!(config.loop_sigma_rad > 0.0)) fail("loop_sigma_rad", "must be > 0");
+  if (config.loop_reference_consensus < 1) fail("loop_reference_consensus", "must be >= 1");
+  if (config.optimize_every_loops < 1) fail("optimize_every_loops", "must be >= 1");
+}
+
+OnlineSlam::OnlineSlam(const SlamConfig& config)
+    : config_(config), odometry_(config.odometry), mapper_(config.mapping) {
+  Validate(config_);
+  map_.config = config_.mapping;
+  map_.pose_source = "slam";
+}
+
+OnlineSlam::~OnlineSlam() = default;
+
+SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
+                             const std::vector<Keypoint>& keypoints) {
+  SlamStep step;
+  auto start = std::chrono::steady_clock::now();
+  step.odometry = odometry_.Add(scan);
+  const Pose2& pose = step.odometry.T_world_robot;
+  if (have_previous_) path_m_ += (pose.translation() - previous_icp_.translation()).norm();
+  previous_icp_ = pose;
+  have_previous_ = true;
+  scans_.push_back({scan_index, scan.timestamp_s, pose, -1});
+  ++stats_.scans;
+  map_.source_scans = stats_.scans;
+  map_.source_keypoints += keypoints.size();
+  stats_.seconds_odometry += SecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  const bool complete = mapper_.AddScan(scan_index, scan, pose, keypoints);
+  stats_.seconds_mapping += SecondsSince(start);
+  if (complete) CompleteSubmap(step);
+  return step;
+}
+
+void OnlineSlam::CompleteSubmap(SlamStep& step) {
+  auto start = std::chrono::steady_clock::now();
+  Submap submap = mapper_.Snapshot();
+  mapper_.Reset();
+  const int id = static_cast<int>(map_.submaps.size());
+  submap.id = id;
+  const std::size_t n_scans = submap.poses.size();
+  for (std::size_t k = first_pending_scan_; k < scans_.size(); ++k) scans_[k].submap = id;
+  first_pending_scan_ = scans_.size();
+  // The path at the submap origin: path now minus the path of its scans after the first.
+  double path_inside = 0.0;
+  for (std::size_t k = 1; k < n_scans; ++k) {
+    path_inside += (submap.poses[k].translation() - submap.poses[k - 1].translation()).norm();
+  }
+  const double origin_path = path_m_ - path_inside;
+  const Pose2 icp_origin = submap.origin();
+
+  // Graph node, initialised through the previous node's corrected pose.
+  if (id == 0) {
+    graph_.AddNode(icp_origin);
+  } else {
+    const Pose2 T_prev_cur = Between(icp_origins_.back(), icp_origin);
+    graph_.AddNode(graph_.node(id - 1) * T_prev_cur);
+    PoseGraphEdge edge;
+    edge.kind = PoseGraphEdge::Kind::kOdometry;
+    edge.from = id - 1;
+    edge.to = id;
+    edge.T_from_to = T_prev_cur;
+    const double d = TranslationNorm(T_prev_cur);
+    const double a = std::abs(T_prev_cur.theta);
+    edge.sigma_x_m = edge.sigma_y_m =
+        config_.odometry_sigma_base_m + config_.odometry_sigma_per_m * d;
+    edge.sigma_theta_rad = config_.odometry_sigma_base_rad + config_.odometry_sigma_per_rad * a +
+                           config_.odometry_sigma_rad_per_m * d;
+    graph_.AddEdge(edge);
+  }
+  icp_origins_.push_back(icp_origin);
+  icp_submap_poses_.push_back(submap.poses);
+  origin_path_m_.push_back(origin_path);
+  // The submap's poses follow its (possibly corrected) node.
+  const Pose2 node = graph_.node(id);
+  for (Pose2& p : submap.poses) p = node * Between(icp_origin, p);
+
+  Place place;
+  place.id = id;
+  place.T_world_place = node;
+  place.scan_indices = submap.scan_indices;
+  for (const StableKeypoint& keypoint : submap.keypoints) {
+    place.positions.push_back(keypoint.position_m);
+    place.descriptors.push_back(keypoint.descriptor);
+  }
+  PlaceQuery query;
+  query.positions = place.positions;
+  query.descriptors = place.descriptors;
+  query.T_first_evaluated = Between(submap.poses.front(), submap.poses.back());
+  map_.submaps.push_back(std::move(submap));
+  places_.push_back(std::move(place));
+  ++stats_.submaps;
+  step.submap_completed = true;
+  step.submap_id = id;
+  stats_.seconds_mapping += SecondsSince(start);
+
+  // Eligible places: a prefix of the map (path grows with the submap index).
+  start = std::chrono::steady_clock::now();
+  std::size_t eligible = 0;
+  while (eligible < places_.size() &&
+         static_cast<int>(eligible) + config_.exclude_recent_submaps < id &&
+         origin_path_m_[eligible] + config_.exclude_recent_path_m <= origin_path) {
+    ++eligible;
+  }
+  if (eligible > 0) {
+    if (!recognizer_ || recognizer_places_ != eligible) {
+      recognizer_ = std::make_unique<PlaceRecognizer>(
+          std::vector<Place>(places_.begin(), places_.begin() + eligible), config_.place);
+      recognizer_places_ = eligible;
+    }
+    ++stats_.queries;
+    step.match = recognizer_->Recognize(query);
+    if (step.match.found) {
+      LoopClosure loop;
+      loop.query_submap = id;
+      loop.reference_submap = step.match.place_id;
+      loop.T_ref_cur = step.match.T_ref_cur;
+      loop.pairs = step.match.pairs;
+      loop.consensus = step.match.consensus;
+      loop.gamma = step.match.gamma;
+      loop.confidence = step.match.confidence;
+      loop.path_between_m = origin_path - origin_path_m_[loop.reference_submap];
+      const Pose2 predicted = Between(graph_.node(loop.reference_submap), graph_.node(id));
+      const Pose2 disagreement = Between(predicted, loop.T_ref_cur);
+      loop.gate_translation_m = TranslationNorm(disagreement);
+      loop.gate_rotation_rad = std::abs(disagreement.theta);
+      loop.accepted = config_.gate_base_m <= 0.0 ||
+                      (loop.gate_translation_m <=
+                           config_.gate_base_m + config_.gate_per_path * loop.path_between_m &&
+                       loop.gate_rotation_rad <=
+                           config_.gate_base_rad + config_.gate_per_path_rad * loop.path_between_m);
+      ++stats_.loops_detected;
+      if (loop.accepted) {
+        PoseGraphEdge edge;
+        edge.kind = PoseGraphEdge::Kind::kLoop;
+        edge.from = loop.reference_submap;
+        edge.to = id;
+        edge.T_from_to = loop.T_ref_cur;
+        const double scale = std::sqrt(static_cast<double>(config_.loop_reference_consensus) /
+                                       std::max(1, loop.consensus));
+        edge.sigma_x_m = edge.sigma_y_m = config_.loop_sigma_m * scale;
+        edge.sigma_theta_rad = config_.loop_sigma_rad * scale;
+        loop.edge = graph_.AddEdge(edge);
+        ++stats_.loops_accepted;
+        ++loops_since_optimization_;
+        dirty_ = true;
+      }
+      step.loop = static_cast<int>(loops_.size());
+      loops_.push_back(loop);
+    }
+  }
+  stats_.seconds_recognition += SecondsSince(start);
+
+  if (loops_since_optimization_ >= config_.optimize_every_loops) {
+    Optimize();
+    step.optimized = true;
+  }
+}
+
+void OnlineSlam::Optimize() {
+  const auto start = std::chrono::steady_clock::now();
+  const PoseGraphResult result = graph_.Optimize(config_.graph);
+  ++stats_.optimizations;
+  stats_.solves += static_cast<std::size_t>(result.solves);
+  loops_since_optimization_ = 0;
+  dirty_ = false;
+  ApplyGraph();
+  std::size_t rejected = 0;
+  for (const LoopClosure& loop : loops_) rejected += (loop.accepted && !LoopUsed(loop)) ? 1 : 0;
+  stats_.loops_rejected_by_graph = rejected;
+  stats_.seconds_optimization += SecondsSince(start);
+}
+
+void OnlineSlam::ApplyGraph() {
+  for (std::size_t i = 0; i < map_.submaps.size(); ++i) {
+    const Pose2 node = graph_.node(static_cast<int>(i));
+    const std::vector<Pose2>& icp = icp_submap_poses_[i];
+    std::vector<Pose2>& poses = map_.submaps[i].poses;
+    for (std::size_t k = 0; k < poses.size(); ++k) poses[k] = node * Between(icp.front(), icp[k]);
+    places_[i].T_world_place = node;
+  }
+}
+
+void OnlineSlam::Finish() {
+  if (dirty_) Optimize();
+}
+
+bool OnlineSlam::LoopUsed(const LoopClosure& loop) const {
+  return loop.accepted && loop.edge >= 0 && graph_.active(loop.edge);
+}
+
+std::vector<OnlineSlam::ScanPose> OnlineSlam::Trajectory() const {
+  std::vector<ScanPose> trajectory;
+  trajectory.reserve(scans_.size());
+  const int last = static_cast<int>(map_.submaps.size()) - 1;
+  for (const ScanRecord& record : scans_) {
+    ScanPose pose;
+    pose.scan_index = record.scan_index;
+    pose.timestamp_s = record.timestamp_s;
+    pose.T_world_robot_icp = record.icp;
+    pose.submap = record.submap;
+    const int anchor = record.submap >= 0 ? record.submap : last;
+    pose.T_world_robot =
+        anchor >= 0 ? graph_.node(anchor) * Between(icp_origins_[anchor], record.icp) : record.icp;
+    trajectory.push_back(pose);
+  }
+  return trajectory;
+}
+
+}  // namespace keyplace
