@@ -17,23 +17,32 @@ std::uint64_t Key(std::int64_t i, std::int64_t j) {
 }  // namespace
 
 double OccupancyOverlap(const OccupancySummary& reference, const OccupancySummary& current,
-                        const Pose2& T_ref_cur) {
+                        const Pose2& T_ref_cur, double cell_m) {
   if (reference.cells.empty() && current.cells.empty()) return 0.0;
   const double l_ref = reference.cell_size_m;
   const double l_cur = current.cell_size_m;
   if (!(l_ref > 0.0) || (!current.cells.empty() && !(l_cur > 0.0))) {
     throw std::invalid_argument("OccupancyOverlap: cell_size_m must be > 0");
   }
+  if (cell_m < 0.0) throw std::invalid_argument("OccupancyOverlap: cell_m must be >= 0");
+  const double l = cell_m > 0.0 ? cell_m : l_ref;
   std::unordered_set<std::uint64_t> a;
   a.reserve(reference.cells.size() * 2);
-  for (const Eigen::Vector2i& c : reference.cells) a.insert(Key(c.x(), c.y()));
+  for (const Eigen::Vector2i& c : reference.cells) {
+    if (cell_m > 0.0) {
+      a.insert(Key(static_cast<std::int64_t>(std::floor((c.x() + 0.5) * l_ref / l)),
+                   static_cast<std::int64_t>(std::floor((c.y() + 0.5) * l_ref / l))));
+    } else {
+      a.insert(Key(c.x(), c.y()));
+    }
+  }
   std::unordered_set<std::uint64_t> b;
   b.reserve(current.cells.size() * 2);
   for (const Eigen::Vector2i& c : current.cells) {
     const Eigen::Vector2d centre((c.x() + 0.5) * l_cur, (c.y() + 0.5) * l_cur);
     const Eigen::Vector2d p = T_ref_cur * centre;
-    b.insert(Key(static_cast<std::int64_t>(std::floor(p.x() / l_ref)),
-                 static_cast<std::int64_t>(std::floor(p.y() / l_ref))));
+    b.insert(Key(static_cast<std::int64_t>(std::floor(p.x() / l)),
+                 static_cast<std::int64_t>(std::floor(p.y() / l))));
   }
   std::size_t intersection = 0;
   for (std::uint64_t key : b) intersection += a.count(key);

@@ -1,5 +1,6 @@
 #include "keyplace/eval/loop_overlap.hpp"
 
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -33,6 +34,14 @@ TEST(OccupancyOverlap, RotationByAQuarterTurnAboutTheCentre) {
   // A 10 x 10 block centred on the origin is its own image under a quarter turn.
   const OccupancySummary a = Block(-5, -5, 10, 10);
   EXPECT_DOUBLE_EQ(OccupancyOverlap(a, a, Pose2(0.0, 0.0, M_PI / 2)), 1.0);
+}
+
+TEST(OccupancyOverlap, CoarserGridForgivesASmallShift) {
+  const OccupancySummary a = Block(0, 0, 10, 1);  // a 1 m wall of 0.1 m cells
+  // Shifted by 0.1 m across the wall: no common 0.1 m cell, the same 0.2 m cells half the time.
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, a, Pose2(0.0, 0.1, 0.0)), 0.0);
+  EXPECT_DOUBLE_EQ(OccupancyOverlap(a, a, Pose2(0.0, 0.05, 0.0), 0.2), 1.0);
+  EXPECT_THROW(OccupancyOverlap(a, a, Pose2(), -1.0), std::invalid_argument);
 }
 
 TEST(OverlapHistogram, PaperBinsAndPrecision) {
