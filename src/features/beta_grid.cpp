@@ -73,8 +73,9 @@ BetaGridDescriptor ComputeBetaGrid(const ScanRays& rays, const Eigen::Vector2d& 
   std::array<double, kCircles> circle_r2;  // circle 2r = inner of ring r, 2r+1 = outer
   double max_radius = 0.0;
   for (int r = 0; r < kRho; ++r) {
-    circle_r2[2 * r] = inner[r] * inner[r];
-    circle_r2[2 * r + 1] = outer[r] * outer[r];
+    const auto inner_circle = 2 * static_cast<std::size_t>(r);
+    circle_r2[inner_circle] = inner[r] * inner[r];
+    circle_r2[inner_circle + 1] = outer[r] * outer[r];
     max_radius = std::max({max_radius, std::fabs(inner[r]), std::fabs(outer[r])});
   }
 
@@ -206,8 +207,9 @@ BetaGridDescriptor ComputeBetaGrid(const ScanRays& rays, const Eigen::Vector2d& 
 
     for (int p = 0; p < kPhi; ++p) {
       for (int r = 0; r < kRho; ++r) {
+        const auto inner_circle = 2 * static_cast<std::size_t>(r);
         const int crossings = ((ring_mask[p][0] >> r) & 1) + ((ring_mask[p][1] >> r) & 1) +
-                              arc_count[2 * r][p] + arc_count[2 * r + 1][p];
+                              arc_count[inner_circle][p] + arc_count[inner_circle + 1][p];
         const int bin = p * kRho + r;
         hit[bin] += crossings == 1;
         miss[bin] += crossings >= 2;

@@ -27,7 +27,9 @@ class ExpNegativeTable {
   }
   double operator()(double x) const {
     if (!(x < 700.0)) return 0.0;  // below 1e-304: nothing at the scale of the central weight
-    const std::int64_t m = static_cast<std::int64_t>(x * kSizeOverLn2 + 0.5);
+    // x >= 0 (a squared distance over 2 sigma^2), so truncating x + 0.5 rounds to nearest.
+    const std::int64_t m =
+        static_cast<std::int64_t>(x * kSizeOverLn2 + 0.5);  // NOLINT(bugprone-incorrect-roundings)
     const double md = static_cast<double>(m);
     const double r = (x - md * kLn2OverSizeHi) - md * kLn2OverSizeLo;
     const double p =
