@@ -165,8 +165,56 @@ void RunSlam(SlamOptions options) {
     });
   }
 
+  // --- ground truth (optional): corrected pose of each raw scan that has one
+  std::vector<Pose2> corrected_poses;
+  std::vector<IndexPair> pairs;
+  std::vector<int> corrected_of(log.scans.size(), -1);
+  if (!options.truth_path.empty()) {
+    const CarmenLog corrected = ReadLogWithScans(options.truth_path);
+    for (const LaserScan& scan : corrected.scans) {
+      if (!scan.corrected_pose) {
+        throw std::invalid_argument(options.truth_path + ":" + std::to_string(scan.line) +
+                                    ": scan has no corrected pose");
+      }
+      corrected_poses.push_back(*scan.corrected_pose);
+    }
+    pairs = ReadIndexPairs(options.index_path);
+    for (const IndexPair& pair : pairs) {
+      if (pair.raw_index < corrected_of.size() && pair.corrected_index < corrected_poses.size()) {
+        corrected_of[pair.raw_index] = static_cast<int>(pair.corrected_index);
+      }
+    }
+  }
+
   // --- loops: overlap of each matched pair under the estimated transform
   const std::vector<LoopClosure>& loops = slam.loops();
+  // Ground-truth check of a loop where both submaps hold a scan with a corrected pose: the
+  // relative pose of those two scans implied by the loop (T_ref_cur and the ICP poses inside each
+  // submap) against the corrected one; correct within 0.5 m and 10 deg (DESIGN.md).
+  std::vector<int> loop_truth(loops.size(), -1);  // -1 unknown, 0 wrong, 1 correct
+  std::vector<double> loop_truth_error_m(loops.size(), -1.0);
+  auto scan_with_truth = [&](const Submap& submap) -> int {
+    for (std::size_t k = 0; k < submap.scan_indices.size(); ++k) {
+      if (corrected_of[submap.scan_indices[k]] >= 0) return static_cast<int>(k);
+    }
+    return -1;
+  };
+  std::size_t truth_evaluated = 0, truth_correct = 0;
+  for (std::size_t k = 0; k < loops.size() && !corrected_poses.empty(); ++k) {
+    const Submap& ref = map.submaps[loops[k].reference_submap];
+    const Submap& cur = map.submaps[loops[k].query_submap];
+    const int ia = scan_with_truth(ref), ib = scan_with_truth(cur);
+    if (ia < 0 || ib < 0) continue;
+    const Pose2 estimated = Between(ref.origin(), ref.poses[ia]).inverse() * loops[k].T_ref_cur *
+                            Between(cur.origin(), cur.poses[ib]);
+    const Pose2 truth = Between(corrected_poses[corrected_of[ref.scan_indices[ia]]],
+                                corrected_poses[corrected_of[cur.scan_indices[ib]]]);
+    const Pose2 error = Between(truth, estimated);
+    loop_truth_error_m[k] = TranslationNorm(error);
+    loop_truth[k] = TranslationNorm(error) <= 0.5 && std::abs(error.theta) <= 10.0 * M_PI / 180.0;
+    ++truth_evaluated;
+    truth_correct += loop_truth[k];
+  }
   std::vector<double> overlaps, overlaps_used, overlaps_coarse;
   std::size_t used = 0;
   for (const LoopClosure& loop : loops) {
@@ -185,21 +233,18 @@ void RunSlam(SlamOptions options) {
   if (!options.loops_path.empty()) {
     WriteFileAtomically(options.loops_path, [&](std::ostream& out) {
       out << "query_submap\tquery_first_scan\treference_submap\treference_first_scan\tx_m\ty_m\t"
-             "theta_rad\tpairs\tconsensus\tgamma\tconfidence\toverlap\toverlap_0_2m\tpath_between_"
-             "m\tgate_m\t"
-             "gate_deg\taccepted\tused\n";
+             "theta_rad\tpairs\tconsensus\tgamma\tconfidence\toverlap\toverlap_0_2m\t"
+             "path_between_m\tgate_m\tgate_deg\taccepted\tused\ttruth_correct\ttruth_error_m\n";
       for (std::size_t k = 0; k < loops.size(); ++k) {
         const LoopClosure& l = loops[k];
         out << fmt::format(
-            "{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.2f}"
-            "\t{:.3f}"
-            "\t"
-            "{:.2f}\t{}\t{}\n",
+            "{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t"
+            "{:.2f}\t{:.3f}\t{:.2f}\t{}\t{}\t{}\t{:.3f}\n",
             l.query_submap, map.submaps[l.query_submap].first_scan(), l.reference_submap,
             map.submaps[l.reference_submap].first_scan(), l.T_ref_cur.x, l.T_ref_cur.y,
             l.T_ref_cur.theta, l.pairs, l.consensus, l.gamma, l.confidence, overlaps[k],
             overlaps_coarse[k], l.path_between_m, l.gate_translation_m, Deg(l.gate_rotation_rad),
-            l.accepted ? 1 : 0, slam.LoopUsed(l) ? 1 : 0);
+            l.accepted ? 1 : 0, slam.LoopUsed(l) ? 1 : 0, loop_truth[k], loop_truth_error_m[k]);
       }
     });
   }
@@ -224,6 +269,13 @@ void RunSlam(SlamOptions options) {
              precision_10, precision_30, precision_used_30);
   fmt::print("                   {:.3f} at 30 % with 0.2 m cells (sensitivity of the measure)\n",
              precision_coarse_30);
+  if (!corrected_poses.empty()) {
+    fmt::print(
+        "                   {:.3f} against ground truth (0.5 m, 10 deg) over the {} loops "
+        "whose submaps both hold a corrected scan\n",
+        truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0,
+        truth_evaluated);
+  }
   fmt::print(
       "overlap histogram  [0,10) {}  [10,20) {}  [20,30) {}  [30,40) {}  [40,100] {}"
       "  ({} below 1 %)\n",
@@ -271,6 +323,12 @@ void RunSlam(SlamOptions options) {
   json["precision_overlap_30_cells_0_2m"] = precision_coarse_30;
   json["precision_overlap_10_cells_0_2m"] = LoopPrecision(overlaps_coarse, 0.1);
   json["loops_below_1_percent_overlap"] = no_overlap;
+  if (!corrected_poses.empty()) {
+    json["loops_truth_evaluated"] = truth_evaluated;
+    json["loops_truth_correct"] = truth_correct;
+    json["precision_truth"] =
+        truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0;
+  }
   json["overlap_histogram"] = histogram.counts;
   json["compression"] = stats.compression;
   json["scans_per_submap"] = stats.scans_per_submap;
@@ -317,16 +375,6 @@ void RunSlam(SlamOptions options) {
   std::vector<RpePoint> rpe;
   AteSeries ate;
   if (!options.truth_path.empty()) {
-    const CarmenLog corrected = ReadLogWithScans(options.truth_path);
-    std::vector<Pose2> corrected_poses;
-    for (const LaserScan& scan : corrected.scans) {
-      if (!scan.corrected_pose) {
-        throw std::invalid_argument(options.truth_path + ":" + std::to_string(scan.line) +
-                                    ": scan has no corrected pose");
-      }
-      corrected_poses.push_back(*scan.corrected_pose);
-    }
-    const std::vector<IndexPair> pairs = ReadIndexPairs(options.index_path);
     const PairedTrajectory paired = PairTrajectory(slam_by_raw, corrected_poses, pairs);
     const PairedTrajectory paired_icp = PairTrajectory(icp_by_raw, corrected_poses, pairs);
     const std::vector<std::size_t> deltas{1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000};
