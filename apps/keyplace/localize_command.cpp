@@ -267,7 +267,7 @@ void RunLocalize(const LocalizeOptions& options) {
         record.match.verified && IsCorrectPose(record.match.estimated_pose, record.truth);
     record.correct = record.match.found && record.verified_correct;
     records.push_back(std::move(record));
-    progress.Update(static_cast<std::size_t>(i + 1));
+    progress.Update(static_cast<std::size_t>(i) + 1);
   }
   progress.Finish();
 
@@ -305,6 +305,7 @@ void RunLocalize(const LocalizeOptions& options) {
 
   auto curve_for = [&](const std::string& key) {
     std::vector<RankedAnswer> answers;
+    answers.reserve(records.size());
     for (const QueryRecord& r : records) {
       answers.push_back({r.match.verified, r.verified_correct, RankScore(key, r.match)});
     }
