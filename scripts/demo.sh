@@ -21,4 +21,9 @@ echo
 echo "== Map of stable keypoints, all completion criteria (used for place recognition)"
 "$keyplace" map "$log" --out "$out/map.kpm" --png "$out/map.png" --json "$out/map.json"
 echo
-echo "Outputs in $out: info.json, features.json, keypoints.tsv, map-table2.json, map.kpm, map.png, map.json"
+echo "== Global localization against that map (paper Algorithm 4, Table III)"
+"$keyplace" localize --map "$out/map.kpm" --log "$log" --json "$out/localize.json" \
+  --queries "$out/localize-queries.tsv" --curve "$out/localize-curve.tsv"
+echo
+echo "Outputs in $out: info.json, features.json, keypoints.tsv, map-table2.json, map.kpm, map.png,"
+echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv"

@@ -42,7 +42,7 @@ json_value() {  # json_value FILE KEY: a top-level number or string of a JSON fi
 }
 
 check "help" "$keyplace" --help
-for command in info features odometry map; do
+for command in info features odometry map localize; do
   check "$command --help" "$keyplace" "$command" --help
 done
 
@@ -70,6 +70,15 @@ assert 0 < j['compression'] < 0.5 and j['submaps'] > 50" "$work/map.json"
 check "map png" test -s "$work/map.png"
 check "info on map" "$keyplace" info "$work/map.kpm" --json "$work/mapinfo.json"
 check "info map submaps" test "$(json_value "$work/mapinfo.json" submaps)" = "$(json_value "$work/map.json" submaps)"
+check "localize" "$keyplace" localize --map "$work/map.kpm" --log "$log" --n-pos 40 \
+  --json "$work/loc.json" --queries "$work/loc.tsv"
+check "localize json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+for k in ['precision','recall','n_pos','n_acc','n_cor','scans_mean','seconds_per_query_mean','p_gl','p_cl']:
+    assert k in j, k
+assert j['n_pos'] == 40 and j['precision'] >= 0.9 and j['recall'] > 0.2, j" "$work/loc.json"
+check "localize queries rows" test "$(($(wc -l <"$work/loc.tsv") - 1))" = 40
 printf 'SQLite format 3\0garbage' >"$work/bad.kpm"
 fails_with "corrupt map" "bad.kpm" "$keyplace" info "$work/bad.kpm"
 
