@@ -21,6 +21,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "eval_json.hpp"
 #include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/eval/relation_error.hpp"
 #include "keyplace/eval/trajectory_error.hpp"
@@ -60,30 +61,6 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 }
 
 double Deg(double rad) { return rad * 180.0 / M_PI; }
-
-nlohmann::json StatsJson(const ErrorStats& s) {
-  return {{"count", s.count},
-          {"translation_mean_m", s.translation_mean_m},
-          {"translation_std_m", s.translation_std_m},
-          {"translation_max_m", s.translation_max_m},
-          {"rotation_mean_deg", s.rotation_mean_deg},
-          {"rotation_std_deg", s.rotation_std_deg},
-          {"rotation_max_deg", s.rotation_max_deg}};
-}
-
-nlohmann::json RelationJson(const RelationErrorReport& r) {
-  nlohmann::json json;
-  json["relations"] = r.relations;
-  json["matched"] = r.matched;
-  json["translation_mean_m"] = r.all.translation_mean_m;
-  json["translation_std_m"] = r.all.translation_std_m;
-  json["rotation_mean_deg"] = r.all.rotation_mean_deg;
-  json["rotation_std_deg"] = r.all.rotation_std_deg;
-  json["all"] = StatsJson(r.all);
-  json["local"] = StatsJson(r.local);
-  json["loop"] = StatsJson(r.loop);
-  return json;
-}
 
 void RunSlam(SlamOptions options) {
   using Clock = std::chrono::steady_clock;

@@ -1,0 +1,40 @@
+#include "eval_json.hpp"
+
+namespace keyplace::cli {
+
+nlohmann::json StatsJson(const ErrorStats& s) {
+  return {{"count", s.count},
+          {"translation_mean_m", s.translation_mean_m},
+          {"translation_std_m", s.translation_std_m},
+          {"translation_max_m", s.translation_max_m},
+          {"rotation_mean_deg", s.rotation_mean_deg},
+          {"rotation_std_deg", s.rotation_std_deg},
+          {"rotation_max_deg", s.rotation_max_deg}};
+}
+
+nlohmann::json RelationJson(const RelationErrorReport& r) {
+  nlohmann::json json;
+  json["relations"] = r.relations;
+  json["matched"] = r.matched;
+  json["unmatched"] = r.unmatched;
+  json["duplicate_timestamps"] = r.duplicate_timestamps;
+  // Flat keys for scripts, then the full statistics per split.
+  json["translation_mean_m"] = r.all.translation_mean_m;
+  json["translation_std_m"] = r.all.translation_std_m;
+  json["rotation_mean_deg"] = r.all.rotation_mean_deg;
+  json["rotation_std_deg"] = r.all.rotation_std_deg;
+  json["local_translation_mean_m"] = r.local.translation_mean_m;
+  json["local_translation_std_m"] = r.local.translation_std_m;
+  json["local_rotation_mean_deg"] = r.local.rotation_mean_deg;
+  json["local_rotation_std_deg"] = r.local.rotation_std_deg;
+  json["loop_translation_mean_m"] = r.loop.translation_mean_m;
+  json["loop_translation_std_m"] = r.loop.translation_std_m;
+  json["loop_rotation_mean_deg"] = r.loop.rotation_mean_deg;
+  json["loop_rotation_std_deg"] = r.loop.rotation_std_deg;
+  json["all"] = StatsJson(r.all);
+  json["local"] = StatsJson(r.local);
+  json["loop"] = StatsJson(r.loop);
+  return json;
+}
+
+}  // namespace keyplace::cli

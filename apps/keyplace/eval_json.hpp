@@ -1,0 +1,17 @@
+#pragma once
+// JSON forms of evaluation results shared by several subcommands.
+
+#include <nlohmann/json.hpp>
+
+#include "keyplace/eval/relation_error.hpp"
+
+namespace keyplace::cli {
+
+/// count, mean / std / max of the translational (m) and rotational (deg) errors.
+nlohmann::json StatsJson(const ErrorStats& stats);
+
+/// The Kümmerle relation error: flat keys for scripts (translation_mean_m, local_*, loop_*) and
+/// the full statistics of each split under "all", "local" and "loop".
+nlohmann::json RelationJson(const RelationErrorReport& report);
+
+}  // namespace keyplace::cli
