@@ -11,6 +11,8 @@ packages=(
   libeigen3-dev libnanoflann-dev libceres-dev zlib1g-dev libsqlite3-dev sqlite3
   libcli11-dev libfmt-dev libspdlog-dev libtbb-dev libcairo2-dev libyaml-cpp-dev
   nlohmann-json3-dev pybind11-dev python3-dev
+  # the CLI tests read JSON with python3
+  python3
   # tests, benchmarks, style
   libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
 )
