@@ -12,5 +12,6 @@ void RegisterOdometryCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
 void RegisterSlamCommand(CLI::App& app);
+void RegisterSweepCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

@@ -22,6 +22,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterMapCommand(app);
   keyplace::cli::RegisterLocalizeCommand(app);
   keyplace::cli::RegisterSlamCommand(app);
+  keyplace::cli::RegisterSweepCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# keyplace sweep: an interrupted sweep (a --stop-after hook, and a real kill -9 half-way) resumes
+# without redoing finished points and ends with the same table as an uninterrupted run on another
+# thread count; a different sweep in the same directory is refused; bad value lists give clear
+# errors. Usage: sweep_test.sh KEYPLACE_BINARY SOURCE_DIR
+set -uo pipefail
+keyplace=$1
+source_dir=$2
+log="$source_dir/data/fr079-corrected.log.gz"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+
+ok() { passed=$((passed + 1)); }
+fail() {
+  failed=$((failed + 1))
+  echo "FAILED: $1"
+}
+
+# The table without the timing column (the last one), rows sorted: what must not depend on
+# interruptions, thread count or completion order.
+table() { cut -d, -f1-"$(($(head -1 "$1" | tr ',' '\n' | wc -l) - 1))" "$1" | sort; }
+rows() { echo $(($(wc -l <"$1") - 1)); }
+
+place_args=(sweep place --map-log "$log" --scans 0:300 --n-pos 40 --mu 5,10 --gamma-min 0:0.8:0.2
+  --lambda 0.05,0.1)
+mapping_args=(sweep mapping --log "$log" --scans 0:300 --s-min 0.1:0.5:0.1 --lg 0.05,0.1,0.15)
+
+for kind in place mapping; do
+  if [ "$kind" = place ]; then args=("${place_args[@]}"); else args=("${mapping_args[@]}"); fi
+  # Uninterrupted reference, one thread.
+  if "$keyplace" "${args[@]}" --threads 1 --out "$work/$kind-ref" >"$work/out" 2>&1; then ok; else
+    fail "$kind: reference run"
+    cat "$work/out"
+  fi
+  total=$(rows "$work/$kind-ref/results.csv")
+  # Stopped after 4 points, then resumed on 2 threads.
+  "$keyplace" "${args[@]}" --threads 2 --stop-after 4 --out "$work/$kind-cut" >"$work/out1" 2>&1
+  first=$(rows "$work/$kind-cut/results.csv")
+  if [ "$first" -ge 4 ] && [ "$first" -lt "$total" ]; then ok; else
+    fail "$kind: --stop-after 4 left $first of $total rows"
+  fi
+  "$keyplace" "${args[@]}" --threads 2 --out "$work/$kind-cut" >"$work/out2" 2>&1
+  if grep -q "points, $first done before" "$work/out2"; then ok; else
+    fail "$kind: resume did not skip the $first finished points"
+    head -3 "$work/out2"
+  fi
+  if [ "$(grep -c '^\[' "$work/out2")" = "$((total - first))" ]; then ok; else
+    fail "$kind: resume computed $(grep -c '^\[' "$work/out2") points, expected $((total - first))"
+  fi
+  if diff <(table "$work/$kind-ref/results.csv") <(table "$work/$kind-cut/results.csv") \
+    >"$work/diff"; then ok; else
+    fail "$kind: resumed table differs from the uninterrupted one"
+    head -10 "$work/diff"
+  fi
+  # results.json holds every row, sorted by point.
+  if python3 - "$work/$kind-cut/results.json" "$total" <<'EOF'; then ok; else fail "$kind: results.json"; fi
+import json, sys
+j = json.load(open(sys.argv[1]))
+keys = [tuple(r[p] for p in j["parameters"]) for r in j["rows"]]
+assert len(keys) == int(sys.argv[2]), (len(keys), sys.argv[2])
+assert keys == sorted(keys), "rows not sorted"
+EOF
+done
+
+# A real interruption: kill -9 half-way through the place sweep, then resume.
+"$keyplace" "${place_args[@]}" --threads 1 --out "$work/killed" >/dev/null 2>&1 &
+pid=$!
+total=$(rows "$work/place-ref/results.csv")
+for _ in $(seq 1 600); do
+  [ -f "$work/killed/results.csv" ] && [ "$(rows "$work/killed/results.csv")" -ge $((total / 2)) ] && break
+  kill -0 "$pid" 2>/dev/null || break
+  sleep 0.05
+done
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+before=$(rows "$work/killed/results.csv")
+echo "killed with $before of $total rows written"
+if "$keyplace" "${place_args[@]}" --threads 2 --out "$work/killed" >"$work/out" 2>&1; then ok; else
+  fail "resume after kill -9"
+  cat "$work/out"
+fi
+if diff <(table "$work/place-ref/results.csv") <(table "$work/killed/results.csv") >/dev/null; then
+  ok
+else fail "table after kill -9 at $before of $total rows differs"; fi
+
+# Another sweep in the same directory is refused, naming what differs.
+if "$keyplace" sweep place --map-log "$log" --scans 0:200 --n-pos 40 --out "$work/place-ref" \
+  >"$work/out" 2>&1; then fail "a different sweep was resumed"; elif
+  grep -q "holds a different sweep ('scans'" "$work/out"; then ok; else
+  fail "refusal message"
+  cat "$work/out"
+fi
+
+# Bad value lists.
+for bad in "0:1" "0:1:0" "1:0:0.1" "0.1,x" "" "0.1,0.1"; do
+  if "$keyplace" sweep mapping --log "$log" --scans 0:50 --s-min "$bad" --out "$work/bad" \
+    >"$work/out" 2>&1; then fail "--s-min '$bad' accepted"; elif
+    grep -q -- "--s-min" "$work/out"; then ok; else
+    fail "--s-min '$bad': error does not name the option"
+    cat "$work/out"
+  fi
+done
+
+echo "sweep_test: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
