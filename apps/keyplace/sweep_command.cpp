@@ -342,11 +342,13 @@ void RunSweepPlace(const SweepOptions& options) {
   std::vector<Prepared> prepared(settings.size());
   const auto map_start = Clock::now();
   Progress map_progress("maps and queries", settings.size());
-  std::atomic<std::size_t> maps_done{0};
+  std::mutex map_progress_mutex;
+  std::size_t maps_done = 0;
   tbb::parallel_for(std::size_t{0}, settings.size(), [&](std::size_t i) {
     prepared[i] = PrepareMapping(
         inputs, MappingConfigAt(base_mapping, settings[i][0], settings[i][1]), options.n_pos);
-    map_progress.Update(maps_done.fetch_add(1) + 1);
+    const std::lock_guard<std::mutex> lock(map_progress_mutex);
+    map_progress.Update(++maps_done);
   });
   map_progress.Finish();
   if (!settings.empty()) {
