@@ -89,8 +89,7 @@ std::vector<double> ParseValueList(const std::string& text, const std::string& o
   std::set<double> seen;
   for (double value : values) {
     if (!seen.insert(value).second) {
-      throw std::invalid_argument(option + " '" + text + "': " + FormatValue(value) +
-                                  " appears twice");
+      throw std::invalid_argument(fmt::format("{} '{}': {} appears twice", option, text, value));
     }
   }
   return values;
