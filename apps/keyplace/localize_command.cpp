@@ -245,6 +245,18 @@ void RunLocalize(const LocalizeOptions& options) {
         query.descriptors.push_back(keypoint.descriptor);
       }
       query.T_first_evaluated = Between(submap->origin(), poses[evaluated]);
+      if (config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+        // Every keypoint of every scan of the query, in the submap frame (the latest scans
+        // first, so that merging keeps their keypoints).
+        for (auto it = submap->scan_indices.rbegin(); it != submap->scan_indices.rend(); ++it) {
+          const Pose2 T_first_laser =
+              Between(submap->origin(), poses[*it]) * log.scans[*it].T_robot_laser;
+          for (const Keypoint& keypoint : keypoints[*it]) {
+            query.all_positions.push_back(T_first_laser * keypoint.position_m);
+            query.all_descriptors.push_back(keypoint.descriptor);
+          }
+        }
+      }
       for (int scan : submap->scan_indices) {
         if (corrected_of[scan] >= 0) query_truth_scans.push_back(corrected_of[scan]);
       }
@@ -318,7 +330,8 @@ void RunLocalize(const LocalizeOptions& options) {
   const auto dataset = DatasetName(options.log_path);
   const std::string dataset_name = dataset ? *dataset : "";
   const PaperLocalizationRow* paper =
-      !baseline && config.min_pairs == 10 && std::abs(config.min_gamma - 0.4) < 1e-9
+      !baseline && config.min_pairs == 10 &&
+              std::abs(config.min_gamma - PlacePreset(options.preset).min_gamma) < 1e-9
           ? PaperLocalization(dataset_name, config.double_match_m)
           : nullptr;
   const PaperPglPcl* paper_x = PaperTableX(dataset_name, baseline ? "tip-flirt" : "ours",
@@ -457,7 +470,8 @@ void RegisterLocalizeCommand(CLI::App& app) {
                    "raw_index<TAB>corrected_index file relating --log to --truth")
       ->check(CLI::ExistingFile);
   command->add_option("--mu", options->mu, "Minimal unique descriptor pairs (default 10)");
-  command->add_option("--gamma-min", options->gamma_min, "gamma_min (default 0.4)");
+  command->add_option("--gamma-min", options->gamma_min,
+                      "gamma_min (default 0.15; 0.4 with --preset paper)");
   command->add_option("--lambda", options->lambda, "lambda in m (default 0.05)");
   command->add_option("--min-confidence", options->min_confidence,
                       "Accept only answers with at least this confidence (0..1)");

@@ -22,6 +22,9 @@ const ConfigFields<PlaceRecognitionConfig>& Fields() {
         .Enum("pair_matching", &C::pair_matching,
               {{C::PairMatching::kQueryOrder, "query_order"},
                {C::PairMatching::kGlobalGreedy, "global_greedy"}})
+        .Enum("query_keypoints", &C::query_keypoints,
+              {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}})
+        .Double("query_merge_m", &C::query_merge_m)
         .Double("inlier_distance_m", &C::inlier_distance_m)
         .Int("ransac_iterations", &C::ransac_iterations)
         .Int("exhaustive_hypotheses_max_pairs", &C::exhaustive_hypotheses_max_pairs)
@@ -30,6 +33,9 @@ const ConfigFields<PlaceRecognitionConfig>& Fields() {
         .Int("seed", &C::seed)
         .Int("verification_neighbours", &C::verification_neighbours)
         .Int("min_consensus", &C::min_consensus)
+        .Enum("consensus_counting", &C::consensus_counting,
+              {{C::ConsensusCounting::kQueryKeypoints, "query_keypoints"},
+               {C::ConsensusCounting::kDistinctReference, "distinct_reference"}})
         .Double("min_gamma", &C::min_gamma)
         .Double("double_match_m", &C::double_match_m)
         .Enum("gamma_counting", &C::gamma_counting,
@@ -62,6 +68,9 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.score = PlaceRecognitionConfig::Score::kGamma;
   config.ambiguity_ratio = 1.0;
   config.verification_neighbours = 0;
+  config.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
+  config.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints;
+  config.min_gamma = 0.4;
   return config;
 }
 
@@ -76,6 +85,7 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.min_pairs >= 2, "min_pairs", "must be >= 2");
   Require(config.max_candidates >= 1, "max_candidates", "must be >= 1");
   Require(config.descriptor_match_chi2 > 0.0, "descriptor_match_chi2", "must be positive");
+  Require(config.query_merge_m >= 0.0, "query_merge_m", "must be >= 0");
   Require(config.inlier_distance_m > 0.0, "inlier_distance_m", "must be positive");
   Require(config.ransac_iterations >= 1, "ransac_iterations", "must be >= 1");
   Require(config.exhaustive_hypotheses_max_pairs >= 0, "exhaustive_hypotheses_max_pairs",

@@ -197,6 +197,37 @@ GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions
   return result;
 }
 
+std::vector<int> MergeNearbyKeypoints(const std::vector<Eigen::Vector2d>& positions,
+                                      double radius_m) {
+  std::vector<int> kept;
+  const double radius2 = radius_m * radius_m;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    bool near = false;
+    if (radius_m > 0.0) {
+      for (int k : kept) {
+        if ((positions[k] - positions[i]).squaredNorm() < radius2) {
+          near = true;
+          break;
+        }
+      }
+    }
+    if (!near) kept.push_back(static_cast<int>(i));
+  }
+  return kept;
+}
+
+int CountConsensus(const std::vector<std::pair<int, int>>& inliers,
+                   PlaceRecognitionConfig::ConsensusCounting counting) {
+  if (counting == PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints) {
+    return static_cast<int>(inliers.size());
+  }
+  std::vector<int> references;
+  references.reserve(inliers.size());
+  for (const auto& inlier : inliers) references.push_back(inlier.second);
+  std::sort(references.begin(), references.end());
+  return static_cast<int>(std::unique(references.begin(), references.end()) - references.begin());
+}
+
 PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config)
     : places_(std::move(places)), config_(config) {
   Validate(config_);
@@ -216,6 +247,23 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     throw std::invalid_argument("PlaceQuery: positions and descriptors differ in size");
   }
   const std::size_t min_pairs = static_cast<std::size_t>(config_.min_pairs);
+  if (query.all_positions.size() != query.all_descriptors.size()) {
+    throw std::invalid_argument("PlaceQuery: all_positions and all_descriptors differ in size");
+  }
+  // The query keypoints paired and verified by RANSAC (the gamma check uses the stable ones).
+  std::vector<Eigen::Vector2d> merged_positions;
+  std::vector<BetaGridDescriptor> merged_descriptors;
+  const std::vector<Eigen::Vector2d>* match_positions = &query.positions;
+  const std::vector<BetaGridDescriptor>* match_descriptors = &query.descriptors;
+  if (config_.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans &&
+      !query.all_positions.empty()) {
+    for (int k : MergeNearbyKeypoints(query.all_positions, config_.query_merge_m)) {
+      merged_positions.push_back(query.all_positions[k]);
+      merged_descriptors.push_back(query.all_descriptors[k]);
+    }
+    match_positions = &merged_positions;
+    match_descriptors = &merged_descriptors;
+  }
 
   // Algorithm 3 against every place: candidates with >= mu unique pairs.
   struct Candidate {
@@ -224,7 +272,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     std::vector<DescriptorPair> pairs;
   };
   std::vector<Candidate> candidates;
-  if (query.positions.size() >= min_pairs) {
+  if (match_positions->size() >= min_pairs) {
     for (std::size_t p = 0; p < places_.size(); ++p) {
       const Place& place = places_[p];
       if (place.positions.size() < min_pairs) continue;  // can never reach mu pairs
@@ -233,7 +281,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
         continue;
       }
       std::vector<DescriptorPair> pairs =
-          MatchDescriptorPairs(query.descriptors, place.descriptors, config_.descriptor_match_chi2,
+          MatchDescriptorPairs(*match_descriptors, place.descriptors, config_.descriptor_match_chi2,
                                config_.pair_matching);
       if (pairs.size() < min_pairs) continue;
       double sum = 0.0;
@@ -304,9 +352,9 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
       reference_descriptors = &extended_descriptors;
     }
     const RansacResult estimate =
-        EstimateRigidTransformRansac(*reference_positions, query.positions, index_pairs, ransac);
+        EstimateRigidTransformRansac(*reference_positions, *match_positions, index_pairs, ransac);
     if (!estimate.valid) continue;
-    const int consensus = static_cast<int>(estimate.inliers.size());
+    const int consensus = CountConsensus(estimate.inliers, config_.consensus_counting);
     if (consensus < config_.min_consensus) continue;  // first check
     const GammaResult gamma =
         ComputeGamma(*reference_positions, *reference_descriptors, query.positions,

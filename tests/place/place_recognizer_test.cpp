@@ -111,6 +111,64 @@ TEST(PlaceRecognizer, ExhaustiveMatchesBruteForceCandidateCount) {
   EXPECT_EQ(match.place_id, 3);
 }
 
+TEST(PlaceRecognizer, AllScanKeypointsRecoverAQueryWithTooFewStableOnes) {
+  // The query's stable keypoints are too few for mu pairs; the keypoints of all its scans (each
+  // place keypoint seen twice, a few mm apart) are enough, and merging removes the duplicates.
+  const std::vector<Place> places = MakePlaces(12, 25, 31);
+  const Pose2 T_place_query(0.8, 0.3, -0.4);
+  PlaceQuery query = MakeQuery(places[5], T_place_query, 20, 0, 7);  // 5 stable keypoints
+  const Pose2 T_query_place = T_place_query.inverse();
+  for (int copy = 0; copy < 2; ++copy) {
+    for (std::size_t k = 0; k < places[5].positions.size(); ++k) {
+      query.all_positions.push_back(T_query_place * places[5].positions[k] +
+                                    Eigen::Vector2d(0.003 * copy, 0.0));
+      query.all_descriptors.push_back(places[5].descriptors[k]);
+    }
+  }
+  PlaceRecognitionConfig stable;
+  stable.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
+  EXPECT_FALSE(PlaceRecognizer(places, stable).Recognize(query).verified);
+
+  PlaceRecognitionConfig all = stable;
+  all.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kAllScans;
+  all.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kDistinctReference;
+  all.min_gamma = 0.0;  // gamma compares the 5 stable query keypoints with the whole place
+  const PlaceMatch match = PlaceRecognizer(places, all).Recognize(query);
+  ASSERT_TRUE(match.found);
+  EXPECT_EQ(match.place_id, 5);
+  EXPECT_NEAR(match.T_ref_cur.theta, T_place_query.theta, 1e-6);
+  EXPECT_EQ(match.consensus, 25);  // distinct place keypoints, not 50 query keypoints
+}
+
+TEST(QueryKeypoints, MergeKeepsTheFirstOfEachCluster) {
+  const std::vector<Eigen::Vector2d> points = {{0.0, 0.0},   {0.03, 0.0}, {1.0, 0.0},
+                                               {0.0, 0.049}, {0.0, 0.06}, {1.0, 0.04}};
+  EXPECT_EQ(MergeNearbyKeypoints(points, 0.05), (std::vector<int>{0, 2, 4}));
+  EXPECT_EQ(MergeNearbyKeypoints(points, 0.0), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_TRUE(MergeNearbyKeypoints({}, 0.05).empty());
+}
+
+TEST(PlaceConfig, PaperPresetKeepsThePapersQueryConsensusAndGamma) {
+  const PlaceRecognitionConfig paper = PlacePreset("paper");
+  EXPECT_EQ(paper.query_keypoints, PlaceRecognitionConfig::QueryKeypoints::kStable);
+  EXPECT_EQ(paper.consensus_counting, PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints);
+  EXPECT_DOUBLE_EQ(paper.min_gamma, 0.4);
+  const PlaceRecognitionConfig standard = PlacePreset("default");
+  EXPECT_EQ(standard.query_keypoints, PlaceRecognitionConfig::QueryKeypoints::kAllScans);
+  PlaceRecognitionConfig copy = standard;
+  ApplyKeyValues({{"query_keypoints", "stable"}, {"consensus_counting", "query_keypoints"}}, copy);
+  EXPECT_EQ(copy.query_keypoints, PlaceRecognitionConfig::QueryKeypoints::kStable);
+  EXPECT_THROW(ApplyKeyValues({{"query_merge_m", "-1"}}, copy), std::invalid_argument);
+}
+
+TEST(Consensus, DistinctReferenceCountsEachReferenceKeypointOnce) {
+  const std::vector<std::pair<int, int>> inliers = {{0, 3}, {1, 3}, {2, 5}, {3, 7}, {4, 5}};
+  EXPECT_EQ(CountConsensus(inliers, PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints), 5);
+  EXPECT_EQ(CountConsensus(inliers, PlaceRecognitionConfig::ConsensusCounting::kDistinctReference),
+            3);
+  EXPECT_EQ(CountConsensus({}, PlaceRecognitionConfig::ConsensusCounting::kDistinctReference), 0);
+}
+
 TEST(PlaceRecognizer, NoMatchWhenNothingFits) {
   const std::vector<Place> places = MakePlaces(10, 20, 1);
   const PlaceRecognizer recognizer(places, PlaceRecognitionConfig{});

@@ -20,6 +20,13 @@ struct PlaceRecognitionConfig {
   // literally). kGlobalGreedy: all pairs below the threshold by increasing distance.
   enum class PairMatching { kQueryOrder, kGlobalGreedy };
   PairMatching pair_matching = PairMatching::kGlobalGreedy;
+  // Which query keypoints go through pairing and RANSAC. kStable: the query submap's stable
+  // keypoints (the paper). kAllScans: every keypoint of every scan of the query submap, in the
+  // submap frame (PlaceQuery::all_positions), merged within query_merge_m; falls back to the
+  // stable keypoints when the query has none. The gamma check always uses the stable keypoints.
+  enum class QueryKeypoints { kStable, kAllScans };
+  QueryKeypoints query_keypoints = QueryKeypoints::kAllScans;
+  double query_merge_m = 0.05;  // kAllScans: a keypoint within this of a kept one is dropped
 
   // --- RANSAC (Section 4.1.1; FLIRTLib's RansacFeatureSetMatcher)
   double inlier_distance_m = 0.1;  // acceptance: a transformed query keypoint within this of its
@@ -39,8 +46,15 @@ struct PlaceRecognitionConfig {
   // Excluded places never contribute. Candidate ranking still uses the candidate alone. 0 = the
   // paper.
   int verification_neighbours = 1;
-  int min_consensus = 9;         // first check: RANSAC inliers
-  double min_gamma = 0.4;        // gamma_min: second check, Eq. (10)
+  int min_consensus = 9;  // first check: RANSAC inliers
+  // How the consensus is counted. kQueryKeypoints: query keypoints with a reference keypoint
+  // within inlier_distance_m (the paper). kDistinctReference: distinct reference keypoints hit by
+  // those inliers (several query keypoints on one reference keypoint count once).
+  enum class ConsensusCounting { kQueryKeypoints, kDistinctReference };
+  ConsensusCounting consensus_counting = ConsensusCounting::kDistinctReference;
+  // gamma_min: second check, Eq. (10). The paper's 0.4 in PaperPlaceConfig(); the default is
+  // lower because the all-scan consensus already rejects wrong candidates (docs/PLACE.md).
+  double min_gamma = 0.15;
   double double_match_m = 0.05;  // lambda: max distance of a doubly matched pair
   // How n_dm counts doubly matched keypoints. kUniquePairs: pairs in a one-to-one matching (by
   // increasing distance), gamma = 2 n_pairs / (n_r + n_c). kPerKeypoint: every keypoint of either

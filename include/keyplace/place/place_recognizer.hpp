@@ -35,7 +35,20 @@ struct PlaceQuery {
   std::vector<Eigen::Vector2d> positions;
   std::vector<BetaGridDescriptor> descriptors;
   Pose2 T_first_evaluated;
+  // Optional: every keypoint of every scan of S_c in the same frame (used with
+  // PlaceRecognitionConfig::QueryKeypoints::kAllScans; may hold near-duplicates, merged there).
+  std::vector<Eigen::Vector2d> all_positions;
+  std::vector<BetaGridDescriptor> all_descriptors;
 };
+
+/// Greedy merge: keeps each keypoint unless one already kept lies within `radius_m` (input order
+/// decides; radius 0 keeps all). Returns the kept indices.
+std::vector<int> MergeNearbyKeypoints(const std::vector<Eigen::Vector2d>& positions,
+                                      double radius_m);
+
+/// The consensus of an inlier set (query index, reference index) under `counting`.
+int CountConsensus(const std::vector<std::pair<int, int>>& inliers,
+                   PlaceRecognitionConfig::ConsensusCounting counting);
 
 /// A descriptor pair of Algorithm 3: (query keypoint, place keypoint, symmetric chi2).
 struct DescriptorPair {
