@@ -103,7 +103,10 @@ void RunLocalize(const LocalizeOptions& options) {
 
   PlaceRecognitionConfig config = PlacePreset(options.preset);
   if (options.mu) config.min_pairs = *options.mu;
-  if (options.gamma_min) config.min_gamma = *options.gamma_min;
+  if (options.gamma_min) {  // for stable and all-scan query keypoints alike
+    config.min_gamma = *options.gamma_min;
+    config.min_gamma_all_scans = *options.gamma_min;
+  }
   if (options.lambda) config.double_match_m = *options.lambda;
   if (options.min_confidence) config.min_confidence = *options.min_confidence;
   ApplyKeyValues(ParseAssignments(options.assignments), config);
@@ -330,8 +333,7 @@ void RunLocalize(const LocalizeOptions& options) {
   const auto dataset = DatasetName(options.log_path);
   const std::string dataset_name = dataset ? *dataset : "";
   const PaperLocalizationRow* paper =
-      !baseline && config.min_pairs == 10 &&
-              std::abs(config.min_gamma - PlacePreset(options.preset).min_gamma) < 1e-9
+      !baseline && config.min_pairs == 10 && std::abs(config.min_gamma - 0.4) < 1e-9
           ? PaperLocalization(dataset_name, config.double_match_m)
           : nullptr;
   const PaperPglPcl* paper_x = PaperTableX(dataset_name, baseline ? "tip-flirt" : "ours",
@@ -470,8 +472,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
                    "raw_index<TAB>corrected_index file relating --log to --truth")
       ->check(CLI::ExistingFile);
   command->add_option("--mu", options->mu, "Minimal unique descriptor pairs (default 10)");
-  command->add_option("--gamma-min", options->gamma_min,
-                      "gamma_min (default 0.15; 0.4 with --preset paper)");
+  command->add_option(
+      "--gamma-min", options->gamma_min,
+      "gamma_min (default 0.4; sets min_gamma and min_gamma_all_scans, default 0.15)");
   command->add_option("--lambda", options->lambda, "lambda in m (default 0.05)");
   command->add_option("--min-confidence", options->min_confidence,
                       "Accept only answers with at least this confidence (0..1)");

@@ -37,6 +37,7 @@ const ConfigFields<PlaceRecognitionConfig>& Fields() {
               {{C::ConsensusCounting::kQueryKeypoints, "query_keypoints"},
                {C::ConsensusCounting::kDistinctReference, "distinct_reference"}})
         .Double("min_gamma", &C::min_gamma)
+        .Double("min_gamma_all_scans", &C::min_gamma_all_scans)
         .Double("double_match_m", &C::double_match_m)
         .Enum("gamma_counting", &C::gamma_counting,
               {{C::GammaCounting::kUniquePairs, "unique_pairs"},
@@ -70,7 +71,7 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.verification_neighbours = 0;
   config.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
   config.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints;
-  config.min_gamma = 0.4;
+  config.min_gamma_all_scans = 0.4;  // unused: stable query keypoints
   return config;
 }
 
@@ -94,6 +95,8 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.verification_neighbours >= 0, "verification_neighbours", "must be >= 0");
   Require(config.min_consensus >= 2, "min_consensus", "must be >= 2");
   Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");
+  Require(config.min_gamma_all_scans >= 0.0 && config.min_gamma_all_scans <= 1.0,
+          "min_gamma_all_scans", "must lie in [0, 1]");
   Require(config.double_match_m > 0.0, "double_match_m", "must be positive");
   Require(config.distinct_distance_m > 0.0, "distinct_distance_m", "must be positive");
   Require(config.distinct_angle_deg > 0.0, "distinct_angle_deg", "must be positive");

@@ -265,6 +265,9 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     match_descriptors = &merged_descriptors;
   }
 
+  const double min_gamma =
+      match_positions == &query.positions ? config_.min_gamma : config_.min_gamma_all_scans;
+
   // Algorithm 3 against every place: candidates with >= mu unique pairs.
   struct Candidate {
     int place_index;
@@ -360,7 +363,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
         ComputeGamma(*reference_positions, *reference_descriptors, query.positions,
                      query.descriptors, estimate.T_ref_cur, config_.double_match_m,
                      config_.descriptor_match_chi2, config_.gamma_counting);
-    if (gamma.gamma < config_.min_gamma) continue;  // second check
+    if (gamma.gamma < min_gamma) continue;  // second check
     CandidateResult result;
     result.place_index = candidate.place_index;
     result.pairs = static_cast<int>(candidate.pairs.size());

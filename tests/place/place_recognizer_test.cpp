@@ -132,12 +132,19 @@ TEST(PlaceRecognizer, AllScanKeypointsRecoverAQueryWithTooFewStableOnes) {
   PlaceRecognitionConfig all = stable;
   all.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kAllScans;
   all.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kDistinctReference;
-  all.min_gamma = 0.0;  // gamma compares the 5 stable query keypoints with the whole place
+  all.min_gamma = 1.0;            // not used: the query comes with all-scan keypoints
+  all.min_gamma_all_scans = 0.0;  // gamma compares the 5 stable query keypoints with the place
   const PlaceMatch match = PlaceRecognizer(places, all).Recognize(query);
   ASSERT_TRUE(match.found);
   EXPECT_EQ(match.place_id, 5);
   EXPECT_NEAR(match.T_ref_cur.theta, T_place_query.theta, 1e-6);
   EXPECT_EQ(match.consensus, 25);  // distinct place keypoints, not 50 query keypoints
+
+  // Without all-scan keypoints the query falls back to its stable ones and to min_gamma.
+  const PlaceQuery stable_query = MakeQuery(places[5], T_place_query, 5, 8, 7);
+  EXPECT_FALSE(PlaceRecognizer(places, all).Recognize(stable_query).verified);
+  all.min_gamma = 0.0;
+  EXPECT_TRUE(PlaceRecognizer(places, all).Recognize(stable_query).found);
 }
 
 TEST(QueryKeypoints, MergeKeepsTheFirstOfEachCluster) {
@@ -155,6 +162,8 @@ TEST(PlaceConfig, PaperPresetKeepsThePapersQueryConsensusAndGamma) {
   EXPECT_DOUBLE_EQ(paper.min_gamma, 0.4);
   const PlaceRecognitionConfig standard = PlacePreset("default");
   EXPECT_EQ(standard.query_keypoints, PlaceRecognitionConfig::QueryKeypoints::kAllScans);
+  EXPECT_DOUBLE_EQ(standard.min_gamma, 0.4);  // stable queries (SLAM) keep the paper's check
+  EXPECT_DOUBLE_EQ(standard.min_gamma_all_scans, 0.15);
   PlaceRecognitionConfig copy = standard;
   ApplyKeyValues({{"query_keypoints", "stable"}, {"consensus_counting", "query_keypoints"}}, copy);
   EXPECT_EQ(copy.query_keypoints, PlaceRecognitionConfig::QueryKeypoints::kStable);

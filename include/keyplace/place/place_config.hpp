@@ -52,9 +52,11 @@ struct PlaceRecognitionConfig {
   // those inliers (several query keypoints on one reference keypoint count once).
   enum class ConsensusCounting { kQueryKeypoints, kDistinctReference };
   ConsensusCounting consensus_counting = ConsensusCounting::kDistinctReference;
-  // gamma_min: second check, Eq. (10). The paper's 0.4 in PaperPlaceConfig(); the default is
-  // lower because the all-scan consensus already rejects wrong candidates (docs/PLACE.md).
-  double min_gamma = 0.15;
+  double min_gamma = 0.4;  // gamma_min: second check, Eq. (10), for stable query keypoints
+  // gamma_min when the query was paired and verified with its all-scan keypoints (kAllScans and
+  // PlaceQuery::all_positions given): lower, because that consensus already rejects wrong
+  // candidates (docs/PLACE.md). Queries with stable keypoints only (e.g. SLAM) keep min_gamma.
+  double min_gamma_all_scans = 0.15;
   double double_match_m = 0.05;  // lambda: max distance of a doubly matched pair
   // How n_dm counts doubly matched keypoints. kUniquePairs: pairs in a one-to-one matching (by
   // increasing distance), gamma = 2 n_pairs / (n_r + n_c). kPerKeypoint: every keypoint of either
