@@ -342,9 +342,14 @@ void RunLocalize(const LocalizeOptions& options) {
   fmt::print("log                {} ({} scans, {} poses), {} queries of {} requested\n",
              options.log_path, log.scans.size(), ToString(source), n_pos, n_requested);
   fmt::print("map                {}\n", map_description);
+  const bool all_scan_queries =
+      config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans;
   fmt::print("config             preset {}, mu {}, gamma_min {}, lambda {} m, self-match {}\n",
-             options.preset, config.min_pairs, config.min_gamma, config.double_match_m,
-             options.exclude_shared_scans ? "shared-scan" : "same-scans");
+             options.preset, config.min_pairs,
+             all_scan_queries
+                 ? fmt::format("{} (all-scan query keypoints)", config.min_gamma_all_scans)
+                 : fmt::format("{}", config.min_gamma),
+             config.double_match_m, options.exclude_shared_scans ? "shared-scan" : "same-scans");
   fmt::print("accepted           {} (verified {}, ambiguous {} of which {} wrong)\n", n_acc,
              n_verified, n_ambiguous, n_ambiguous_wrong);
   fmt::print("correct            {}\n", n_cor);
