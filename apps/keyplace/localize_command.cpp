@@ -26,6 +26,7 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/place/place_recognizer.hpp"
+#include "keyplace/place/submap_query.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "paper_tables.hpp"
 
@@ -243,23 +244,7 @@ void RunLocalize(const LocalizeOptions& options) {
       }
       record.evaluated_scan = evaluated;  // >= 0: the start scan has a truth pose
       record.scans = static_cast<int>(submap->scan_indices.size());
-      for (const StableKeypoint& keypoint : submap->keypoints) {
-        query.positions.push_back(keypoint.position_m);
-        query.descriptors.push_back(keypoint.descriptor);
-      }
-      query.T_first_evaluated = Between(submap->origin(), poses[evaluated]);
-      if (config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
-        // Every keypoint of every scan of the query, in the submap frame (the latest scans
-        // first, so that merging keeps their keypoints).
-        for (auto it = submap->scan_indices.rbegin(); it != submap->scan_indices.rend(); ++it) {
-          const Pose2 T_first_laser =
-              Between(submap->origin(), poses[*it]) * log.scans[*it].T_robot_laser;
-          for (const Keypoint& keypoint : keypoints[*it]) {
-            query.all_positions.push_back(T_first_laser * keypoint.position_m);
-            query.all_descriptors.push_back(keypoint.descriptor);
-          }
-        }
-      }
+      query = MakeSubmapQuery(*submap, sequence, evaluated, config.query_keypoints);
       for (int scan : submap->scan_indices) {
         if (corrected_of[scan] >= 0) query_truth_scans.push_back(corrected_of[scan]);
       }

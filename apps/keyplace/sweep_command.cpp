@@ -28,6 +28,7 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/place/place_recognizer.hpp"
+#include "keyplace/place/submap_query.hpp"
 #include "sweep_grid.hpp"
 
 namespace keyplace::cli {
@@ -247,7 +248,8 @@ struct Prepared {
   std::size_t submaps = 0;
 };
 
-Prepared PrepareMapping(const SharedInputs& inputs, const MappingConfig& config, int n_pos) {
+Prepared PrepareMapping(const SharedInputs& inputs, const MappingConfig& config, int n_pos,
+                        PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
   const ScanSequence sequence{inputs.log.scans, inputs.poses, inputs.keypoints};
   Prepared prepared;
   const GlobalMap map = BuildGlobalMap(sequence, config);
@@ -262,11 +264,7 @@ Prepared PrepareMapping(const SharedInputs& inputs, const MappingConfig& config,
     const int evaluated = submap->scan_indices.back();
     Query query;
     query.scan_count = static_cast<int>(submap->scan_indices.size());
-    for (const StableKeypoint& keypoint : submap->keypoints) {
-      query.query.positions.push_back(keypoint.position_m);
-      query.query.descriptors.push_back(keypoint.descriptor);
-    }
-    query.query.T_first_evaluated = Between(submap->origin(), inputs.poses[evaluated]);
+    query.query = MakeSubmapQuery(*submap, sequence, evaluated, query_keypoints);
     query.scans = submap->scan_indices;
     std::sort(query.scans.begin(), query.scans.end());
     query.truth = *inputs.log.scans[evaluated].corrected_pose;
@@ -299,7 +297,8 @@ void RunSweepPlace(const SweepOptions& options) {
   auto place_config_at = [&](const std::vector<double>& point) {
     PlaceRecognitionConfig config = base_place;
     config.min_pairs = static_cast<int>(point[2]);
-    config.min_gamma = point[3];
+    config.min_gamma = point[3];  // the threshold in force, as localize's --gamma-min
+    config.min_gamma_all_scans = point[3];
     config.double_match_m = point[4];
     Validate(config);
     return config;
@@ -345,8 +344,9 @@ void RunSweepPlace(const SweepOptions& options) {
   std::mutex map_progress_mutex;
   std::size_t maps_done = 0;
   tbb::parallel_for(std::size_t{0}, settings.size(), [&](std::size_t i) {
-    prepared[i] = PrepareMapping(
-        inputs, MappingConfigAt(base_mapping, settings[i][0], settings[i][1]), options.n_pos);
+    prepared[i] =
+        PrepareMapping(inputs, MappingConfigAt(base_mapping, settings[i][0], settings[i][1]),
+                       options.n_pos, base_place.query_keypoints);
     const std::lock_guard<std::mutex> lock(map_progress_mutex);
     map_progress.Update(++maps_done);
   });
