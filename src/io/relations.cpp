@@ -4,7 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <sstream>
+#include <functional>
 #include <stdexcept>
 #include <string_view>
 
@@ -53,18 +53,30 @@ std::size_t ParseIndex(std::string_view text, const std::string& path, std::size
   return value;
 }
 
-std::ifstream OpenOrThrow(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open '" + path + "'");
-  return in;
-}
-
 bool SkipLine(std::string_view line) {
   for (const char c : line) {
     if (std::isspace(static_cast<unsigned char>(c))) continue;
     return c == '#';
   }
   return true;  // blank
+}
+
+// Calls `handle(line_number, fields)` for every line of a text table that is neither blank nor a
+// '#' comment. Throws std::runtime_error naming the path when it cannot be read.
+void ForEachDataLine(
+    const std::string& path,
+    const std::function<void(std::size_t, const std::vector<std::string_view>&)>& handle) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open '" + path + "'");
+  std::string text;
+  std::size_t line = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (SkipLine(text)) continue;
+    handle(line, SplitFields(text));
+  }
+  if (in.bad()) throw std::runtime_error("error while reading '" + path + "'");
 }
 
 }  // namespace
@@ -74,16 +86,9 @@ std::int64_t TimestampKey(double timestamp_s) {
 }
 
 std::vector<Relation> ReadRelations(const std::string& path) {
-  std::ifstream in = OpenOrThrow(path);
   static const char* const kFields[] = {"t_a", "t_b", "dx", "dy", "dz", "droll", "dpitch", "dyaw"};
   std::vector<Relation> relations;
-  std::string text;
-  std::size_t line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (SkipLine(text)) continue;
-    const std::vector<std::string_view> fields = SplitFields(text);
+  ForEachDataLine(path, [&](std::size_t line, const std::vector<std::string_view>& fields) {
     if (fields.size() != 8) {
       Fail(path, line,
            "expected 8 fields (t_a t_b dx dy dz droll dpitch dyaw), found " +
@@ -97,23 +102,15 @@ std::vector<Relation> ReadRelations(const std::string& path) {
     relation.T_a_b = Pose2(values[2], values[3], values[7]);
     relation.line = line;
     relations.push_back(relation);
-  }
-  if (in.bad()) throw std::runtime_error("error while reading '" + path + "'");
+  });
   return relations;
 }
 
 std::vector<IndexPair> ReadIndexPairs(const std::string& path) {
-  std::ifstream in = OpenOrThrow(path);
   std::vector<IndexPair> pairs;
-  std::string text;
-  std::size_t line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (SkipLine(text)) continue;
-    const std::vector<std::string_view> fields = SplitFields(text);
+  ForEachDataLine(path, [&](std::size_t line, const std::vector<std::string_view>& fields) {
     if (line == 1 && !fields.empty() && std::isalpha(static_cast<unsigned char>(fields[0][0]))) {
-      continue;  // header
+      return;  // header
     }
     if (fields.size() != 2) {
       Fail(path, line,
@@ -121,8 +118,7 @@ std::vector<IndexPair> ReadIndexPairs(const std::string& path) {
     }
     pairs.push_back({ParseIndex(fields[0], path, line, "raw_index"),
                      ParseIndex(fields[1], path, line, "corrected_index")});
-  }
-  if (in.bad()) throw std::runtime_error("error while reading '" + path + "'");
+  });
   return pairs;
 }
 
