@@ -107,13 +107,19 @@ void RunLocalize(const LocalizeOptions& options) {
   if (options.gamma_min) {  // for stable and all-scan query keypoints alike
     config.min_gamma = *options.gamma_min;
     config.min_gamma_all_scans = *options.gamma_min;
+  } else if (baseline) {
+    // Tipaldi's protocol accepts on the RANSAC consensus alone; a gamma check between two single
+    // scans at lambda = 0.05 m rejects most true neighbours (docs/PLACE.md, "TIP-FLIRT").
+    config.min_gamma = 0.0;
+    config.min_gamma_all_scans = 0.0;
   }
   if (options.lambda) config.double_match_m = *options.lambda;
   if (options.min_confidence) config.min_confidence = *options.min_confidence;
   ApplyKeyValues(ParseAssignments(options.assignments), config);
-  const std::string rank_by = !options.rank_by.empty()
-                                  ? options.rank_by
-                                  : (options.preset == "paper" ? "gamma" : "confidence");
+  std::string rank_by = options.rank_by;
+  if (rank_by.empty()) {
+    rank_by = baseline ? "consensus" : (options.preset == "paper" ? "gamma" : "confidence");
+  }
   const SelfMatchRule rule =
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
 
@@ -327,8 +333,9 @@ void RunLocalize(const LocalizeOptions& options) {
   fmt::print("log                {} ({} scans, {} poses), {} queries of {} requested\n",
              options.log_path, log.scans.size(), ToString(source), n_pos, n_requested);
   fmt::print("map                {}\n", map_description);
+  // Single-scan baseline queries carry no all-scan keypoints, so min_gamma applies to them.
   const bool all_scan_queries =
-      config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans;
+      !baseline && config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans;
   fmt::print("config             preset {}, mu {}, gamma_min {}, lambda {} m, self-match {}\n",
              options.preset, config.min_pairs,
              all_scan_queries
@@ -464,7 +471,8 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--mu", options->mu, "Minimal unique descriptor pairs (default 10)");
   command->add_option(
       "--gamma-min", options->gamma_min,
-      "gamma_min (default 0.4; sets min_gamma and min_gamma_all_scans, default 0.15)");
+      "gamma_min (default 0.4; sets min_gamma and min_gamma_all_scans, default 0.15; 0 with "
+      "--baseline tip-flirt)");
   command->add_option("--lambda", options->lambda, "lambda in m (default 0.05)");
   command->add_option("--min-confidence", options->min_confidence,
                       "Accept only answers with at least this confidence (0..1)");
@@ -482,12 +490,14 @@ void RegisterLocalizeCommand(CLI::App& app) {
                     "built from exactly the query's scans, the paper's rule)");
   command
       ->add_option("--baseline", options->baseline,
-                   "tip-flirt: every scan of the corrected log is a place, each query one scan")
+                   "tip-flirt: every scan of the corrected log is a place, each query one scan, "
+                   "accepted on the RANSAC consensus (no gamma check unless --gamma-min), ranked "
+                   "by consensus")
       ->check(CLI::IsMember({"tip-flirt"}));
   command
       ->add_option("--rank-by", options->rank_by,
                    "Score ranking answers for the P/R curve: confidence (default preset), gamma "
-                   "(paper preset), consensus or score")
+                   "(paper preset), consensus (tip-flirt) or score")
       ->check(CLI::IsMember({"confidence", "gamma", "consensus", "score"}));
   command->add_option("--json", options->json_path, "Write the figures as JSON to FILE");
   command->add_option("--queries", options->queries_path, "Write one TSV row per query to FILE");

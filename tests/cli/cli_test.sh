@@ -79,6 +79,15 @@ for k in ['precision','recall','n_pos','n_acc','n_cor','scans_mean','seconds_per
     assert k in j, k
 assert j['n_pos'] == 40 and j['precision'] >= 0.9 and j['recall'] > 0.2, j" "$work/loc.json"
 check "localize queries rows" test "$(($(wc -l <"$work/loc.tsv") - 1))" = 40
+# TIP-FLIRT accepts on the RANSAC consensus (no gamma check); with the gamma check of the
+# submap queries most single-scan neighbours fail (recall about 0.4 on this log).
+check "tip-flirt baseline" "$keyplace" localize --baseline tip-flirt --log "$log" --n-pos 20 \
+  --json "$work/tip.json"
+check "tip-flirt json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert j['config']['min_gamma'] == 0 and j['rank_by'] == 'consensus', j['config']
+assert j['n_pos'] == 20 and j['precision'] >= 0.9 and j['recall'] >= 0.7, j" "$work/tip.json"
 printf 'SQLite format 3\0garbage' >"$work/bad.kpm"
 fails_with "corrupt map" "bad.kpm" "$keyplace" info "$work/bad.kpm"
 

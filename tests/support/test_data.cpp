@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
+#include <vector>
 
 namespace keyplace::testing {
 namespace fs = std::filesystem;
@@ -29,9 +31,38 @@ std::string SharedFile(const std::string& relative) {
   return path.string();
 }
 
+namespace {
+
+// Removes the test's temporary directories when the test program exits, so that repeated test
+// runs do not fill /tmp.
+class TempDirRegistry {
+ public:
+  TempDirRegistry() = default;
+  TempDirRegistry(const TempDirRegistry&) = delete;
+  TempDirRegistry& operator=(const TempDirRegistry&) = delete;
+  ~TempDirRegistry() {
+    for (const std::string& dir : dirs_) {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+  }
+  void Add(const std::string& dir) { dirs_.push_back(dir); }
+
+ private:
+  std::vector<std::string> dirs_;
+};
+
+TempDirRegistry& Registry() {
+  static TempDirRegistry registry;
+  return registry;
+}
+
+}  // namespace
+
 std::string MakeTempDir(const std::string& prefix) {
   std::string pattern = (fs::temp_directory_path() / (prefix + "-XXXXXX")).string();
   if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed: " + pattern);
+  Registry().Add(pattern);
   return pattern;
 }
 

@@ -15,7 +15,8 @@ std::string SharedDir();
 /// <shared>/<relative>; throws std::runtime_error naming the path when it is missing.
 std::string SharedFile(const std::string& relative);
 
-/// A fresh empty temporary directory for one test.
+/// A fresh empty temporary directory for one test, removed with its contents when the test
+/// program exits.
 std::string MakeTempDir(const std::string& prefix);
 
 }  // namespace keyplace::testing
