@@ -86,7 +86,7 @@ check "tip-flirt baseline" "$keyplace" localize --baseline tip-flirt --log "$log
 check "tip-flirt json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
-assert j['config']['min_gamma'] == 0 and j['rank_by'] == 'consensus', j['config']
+assert float(j['config']['min_gamma']) == 0 and j['rank_by'] == 'consensus', j['config']
 assert j['n_pos'] == 20 and j['precision'] >= 0.9 and j['recall'] >= 0.7, j" "$work/tip.json"
 printf 'SQLite format 3\0garbage' >"$work/bad.kpm"
 fails_with "corrupt map" "bad.kpm" "$keyplace" info "$work/bad.kpm"
