@@ -15,6 +15,8 @@ packages=(
   python3
   # tests, benchmarks, style
   libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
+  # the report check opens the page in headless Chromium (scripts/check-report.sh)
+  chromium
 )
 
 missing=()

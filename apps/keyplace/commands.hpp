@@ -13,5 +13,6 @@ void RegisterMapCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
 void RegisterSlamCommand(CLI::App& app);
 void RegisterSweepCommand(CLI::App& app);
+void RegisterReportCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

@@ -23,6 +23,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterLocalizeCommand(app);
   keyplace::cli::RegisterSlamCommand(app);
   keyplace::cli::RegisterSweepCommand(app);
+  keyplace::cli::RegisterReportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
