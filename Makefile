@@ -5,8 +5,10 @@ JOBS ?= $(shell nproc)
 KEYPLACE := $(BUILD_DIR)/keyplace
 DEMO_LOG := data/fr079-corrected.log.gz
 DEMO_OUT := $(BUILD_DIR)/demo
+REPORT_DIR ?= $(BUILD_DIR)/report
+KEYPLACE_SHARED ?= ../shared
 
-.PHONY: all deps configure build demo test bench format format-check tidy install clean
+.PHONY: all deps configure build demo test bench report format format-check tidy install clean
 
 all: build
 
@@ -26,8 +28,17 @@ demo: build
 test: build format-check
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
+# Every bench/*_bench program (docs/BENCHMARKS.md), medians of 3 repetitions.
 bench: build
-	@bash scripts/run-benchmarks.sh $(BUILD_DIR)
+	@set -e; for program in $(BUILD_DIR)/bench/*_bench; do \
+	  echo "== $$program"; \
+	  $$program --benchmark_repetitions=3 --benchmark_report_aggregates_only=true; \
+	done
+
+# Every figure and table of the paper for all six data sets, ours beside the paper's, in
+# $(REPORT_DIR)/index.html (docs/REPORT.md: what it runs and how long it takes). Resumable.
+report: build
+	@$(KEYPLACE) report --out $(REPORT_DIR) --data $(KEYPLACE_SHARED)/data --threads $(JOBS)
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
