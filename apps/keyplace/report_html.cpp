@@ -145,7 +145,8 @@ std::string ComparisonTableHtml(const std::string& anchor, const std::string& ti
           html += fmt::format("<br><span class=\"diff\">{}{}", diff >= 0 ? "+" : "−",
                               FormatValue(std::abs(diff), columns[c].digits));
           if (std::abs(*paper) > 1e-12) {
-            html += fmt::format(" ({:+.0f} %)", 100.0 * diff / std::abs(*paper));
+            const double percent = 100.0 * diff / std::abs(*paper);
+            html += fmt::format(" ({}{:.0f} %)", percent < -0.5 ? "−" : "+", std::abs(percent));
           }
           html += "</span>";
         }
