@@ -54,6 +54,7 @@ struct SlamOptions {
   std::vector<std::string> place_assignments;
   SlamConfig config;
   bool no_gate = false;
+  bool no_loop_refine = false;
 };
 
 double Seconds(std::chrono::steady_clock::time_point start) {
@@ -73,6 +74,7 @@ void RunSlam(SlamOptions options) {
   config.place = PlacePreset(options.place_preset);
   ApplyKeyValues(ParseAssignments(options.place_assignments), config.place);
   if (options.no_gate) config.gate_base_m = 0.0;
+  if (options.no_loop_refine) config.loop_refinement.refine = false;
   Validate(config);
 
   const CarmenLog log = ReadLogWithScans(options.input);
@@ -176,25 +178,59 @@ void RunSlam(SlamOptions options) {
     }
     return -1;
   };
-  std::size_t truth_evaluated = 0, truth_correct = 0;
-  for (std::size_t k = 0; k < loops.size() && !corrected_poses.empty(); ++k) {
-    const Submap& ref = map.submaps[loops[k].reference_submap];
-    const Submap& cur = map.submaps[loops[k].query_submap];
+  // Error of the loop transform T_ref_cur between submaps `ref_id` and `cur_id` at the first
+  // scans of each holding a corrected pose; false when one of them holds none.
+  auto truth_error = [&](int ref_id, int cur_id, const Pose2& T_ref_cur, Pose2* error) {
+    const Submap& ref = map.submaps[ref_id];
+    const Submap& cur = map.submaps[cur_id];
     const int ia = scan_with_truth(ref), ib = scan_with_truth(cur);
-    if (ia < 0 || ib < 0) continue;
-    const Pose2 estimated = Between(ref.origin(), ref.poses[ia]).inverse() * loops[k].T_ref_cur *
+    if (ia < 0 || ib < 0) return false;
+    const Pose2 estimated = Between(ref.origin(), ref.poses[ia]).inverse() * T_ref_cur *
                             Between(cur.origin(), cur.poses[ib]);
     const Pose2 truth = Between(corrected_poses[corrected_of[ref.scan_indices[ia]]],
                                 corrected_poses[corrected_of[cur.scan_indices[ib]]]);
-    const Pose2 error = Between(truth, estimated);
-    loop_truth_error_m[k] = TranslationNorm(error);
-    loop_truth[k] = TranslationNorm(error) <= 0.5 && std::abs(error.theta) <= 10.0 * M_PI / 180.0;
-    ++truth_evaluated;
-    truth_correct += loop_truth[k];
+    *error = Between(truth, estimated);
+    return true;
+  };
+  std::size_t truth_evaluated = 0, truth_correct = 0;
+  std::vector<double> loop_truth_error_deg(loops.size(), -1.0);
+  // The same check of place recognition's own estimate (matched submap, RANSAC), where both the
+  // final and that one can be checked: the accuracy gained by the refinement.
+  std::vector<double> loop_truth_ransac_m(loops.size(), -1.0);
+  std::vector<double> loop_truth_ransac_deg(loops.size(), -1.0);
+  std::vector<double> paired_final_m, paired_ransac_m, paired_final_deg, paired_ransac_deg;
+  for (std::size_t k = 0; k < loops.size() && !corrected_poses.empty(); ++k) {
+    Pose2 error;
+    if (truth_error(loops[k].reference_submap, loops[k].query_submap, loops[k].T_ref_cur, &error)) {
+      loop_truth_error_m[k] = TranslationNorm(error);
+      loop_truth_error_deg[k] = std::abs(Deg(error.theta));
+      loop_truth[k] = TranslationNorm(error) <= 0.5 && std::abs(error.theta) <= 10.0 * M_PI / 180.0;
+      ++truth_evaluated;
+      truth_correct += loop_truth[k];
+    }
+    Pose2 ransac_error;
+    if (truth_error(loops[k].matched_submap, loops[k].query_submap, loops[k].T_matched_cur_ransac,
+                    &ransac_error)) {
+      loop_truth_ransac_m[k] = TranslationNorm(ransac_error);
+      loop_truth_ransac_deg[k] = std::abs(Deg(ransac_error.theta));
+      if (loop_truth[k] >= 0) {
+        paired_final_m.push_back(loop_truth_error_m[k]);
+        paired_final_deg.push_back(loop_truth_error_deg[k]);
+        paired_ransac_m.push_back(loop_truth_ransac_m[k]);
+        paired_ransac_deg.push_back(loop_truth_ransac_deg[k]);
+      }
+    }
   }
-  std::vector<double> overlaps, overlaps_used, overlaps_coarse;
+  auto mean = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+  };
+  std::vector<double> overlaps, overlaps_used, overlaps_coarse, overlaps_ransac;
   std::size_t used = 0;
   for (const LoopClosure& loop : loops) {
+    // Diagnostic: the overlap before refinement and partner choice (matched submap, RANSAC).
+    overlaps_ransac.push_back(OccupancyOverlap(map.submaps[loop.matched_submap].occupancy,
+                                               map.submaps[loop.query_submap].occupancy,
+                                               loop.T_matched_cur_ransac));
     const double overlap =
         OccupancyOverlap(map.submaps[loop.reference_submap].occupancy,
                          map.submaps[loop.query_submap].occupancy, loop.T_ref_cur);
@@ -211,17 +247,27 @@ void RunSlam(SlamOptions options) {
     WriteFileAtomically(options.loops_path, [&](std::ostream& out) {
       out << "query_submap\tquery_first_scan\treference_submap\treference_first_scan\tx_m\ty_m\t"
              "theta_rad\tpairs\tconsensus\tgamma\tconfidence\toverlap\toverlap_0_2m\t"
-             "path_between_m\tgate_m\tgate_deg\taccepted\tused\ttruth_correct\ttruth_error_m\n";
+             "path_between_m\tgate_m\tgate_deg\taccepted\tused\ttruth_correct\ttruth_error_m\t"
+             "matched_submap\tref_x_m\tref_y_m\tref_theta_rad\toverlap_matched_ransac\trefined\t"
+             "refine_correction_m\trefine_correction_deg\tinlier_ratio_initial\tinlier_ratio\t"
+             "point_overlap\trefine_status\ttruth_error_deg\ttruth_error_ransac_m\t"
+             "truth_error_ransac_deg\n";
       for (std::size_t k = 0; k < loops.size(); ++k) {
         const LoopClosure& l = loops[k];
         out << fmt::format(
             "{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t"
-            "{:.2f}\t{:.3f}\t{:.2f}\t{}\t{}\t{}\t{:.3f}\n",
+            "{:.2f}\t{:.3f}\t{:.2f}\t{}\t{}\t{}\t{:.3f}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{:.4f}\t{}\t"
+            "{:.4f}\t{:.3f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.3f}\t{:.3f}\t{:.3f}\n",
             l.query_submap, map.submaps[l.query_submap].first_scan(), l.reference_submap,
             map.submaps[l.reference_submap].first_scan(), l.T_ref_cur.x, l.T_ref_cur.y,
             l.T_ref_cur.theta, l.pairs, l.consensus, l.gamma, l.confidence, overlaps[k],
             overlaps_coarse[k], l.path_between_m, l.gate_translation_m, Deg(l.gate_rotation_rad),
-            l.accepted ? 1 : 0, slam.LoopUsed(l) ? 1 : 0, loop_truth[k], loop_truth_error_m[k]);
+            l.accepted ? 1 : 0, slam.LoopUsed(l) ? 1 : 0, loop_truth[k], loop_truth_error_m[k],
+            l.matched_submap, l.T_matched_cur_ransac.x, l.T_matched_cur_ransac.y,
+            l.T_matched_cur_ransac.theta, overlaps_ransac[k], l.refined ? 1 : 0,
+            l.refine_correction_m, Deg(l.refine_correction_rad), l.refine_inlier_ratio_initial,
+            l.refine_inlier_ratio, l.point_overlap, ToString(l.refine_status),
+            loop_truth_error_deg[k], loop_truth_ransac_m[k], loop_truth_ransac_deg[k]);
       }
     });
   }
@@ -240,6 +286,14 @@ void RunSlam(SlamOptions options) {
   fmt::print("submaps            {} ({} queried)\n", s.submaps, s.queries);
   fmt::print("loops              {} detected, {} accepted by the gate, {} used in the graph\n",
              loops.size(), s.loops_accepted, used);
+  fmt::print(
+      "loop refinement    {} refined by ICP, {} with a neighbour of the matched submap as "
+      "partner; precision at 30 % before refinement and partner choice {:.3f}\n",
+      s.loops_refined, s.loops_partner_changed, LoopPrecision(overlaps_ransac, 0.3));
+  if (config.loop_refinement.min_point_overlap > 0.0) {
+    fmt::print("                   {} matches dropped by --loop-min-point-overlap {:.2f}\n",
+               s.loops_rejected_by_point_overlap, config.loop_refinement.min_point_overlap);
+  }
   fmt::print("optimisations      {} ({} Ceres solves, {:.2f} s)\n", s.optimizations, s.solves,
              s.seconds_optimization);
   fmt::print("loop precision     {:.3f} at 10 % overlap, {:.3f} at 30 % ({:.3f} of the used)\n",
@@ -252,6 +306,11 @@ void RunSlam(SlamOptions options) {
         "whose submaps both hold a corrected scan\n",
         truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0,
         truth_evaluated);
+    fmt::print(
+        "                   loop transform error against ground truth, mean over {} loops: "
+        "{:.3f} m / {:.2f} deg (place recognition's RANSAC estimate: {:.3f} m / {:.2f} deg)\n",
+        paired_final_m.size(), mean(paired_final_m), mean(paired_final_deg), mean(paired_ransac_m),
+        mean(paired_ransac_deg));
   }
   fmt::print(
       "overlap histogram  [0,10) {}  [10,20) {}  [20,30) {}  [30,40) {}  [40,100] {}"
@@ -292,6 +351,10 @@ void RunSlam(SlamOptions options) {
   json["loops_detected"] = loops.size();
   json["loops_accepted"] = s.loops_accepted;
   json["loops_used"] = used;
+  json["loops_refined"] = s.loops_refined;
+  json["loops_partner_changed"] = s.loops_partner_changed;
+  json["loops_rejected_by_point_overlap"] = s.loops_rejected_by_point_overlap;
+  json["precision_overlap_30_matched_ransac"] = LoopPrecision(overlaps_ransac, 0.3);
   json["optimizations"] = s.optimizations;
   json["ceres_solves"] = s.solves;
   json["precision_overlap_10"] = precision_10;
@@ -303,6 +366,11 @@ void RunSlam(SlamOptions options) {
   if (!corrected_poses.empty()) {
     json["loops_truth_evaluated"] = truth_evaluated;
     json["loops_truth_correct"] = truth_correct;
+    json["loop_truth_error"] = {{"loops", paired_final_m.size()},
+                                {"translation_mean_m", mean(paired_final_m)},
+                                {"rotation_mean_deg", mean(paired_final_deg)},
+                                {"ransac_translation_mean_m", mean(paired_ransac_m)},
+                                {"ransac_rotation_mean_deg", mean(paired_ransac_deg)}};
     json["precision_truth"] =
         truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0;
   }
@@ -333,6 +401,10 @@ void RunSlam(SlamOptions options) {
                     {"optimize_every_loops", config.optimize_every_loops},
                     {"loop_reject_sigmas", config.graph.loop_reject_sigmas},
                     {"loop_loss_scale", config.graph.loop_loss_scale},
+                    {"loop_refine", config.loop_refinement.refine},
+                    {"loop_partner_neighbours", config.loop_refinement.partner_neighbours},
+                    {"loop_max_inlier_ratio_loss", config.loop_refinement.max_inlier_ratio_loss},
+                    {"loop_min_point_overlap", config.loop_refinement.min_point_overlap},
                     {"place_preset", options.place_preset}};
   if (paper) {
     json["paper"] = {{"compression", paper->compression},
@@ -509,6 +581,18 @@ void RegisterSlamCommand(CLI::App& app) {
   command
       ->add_option("--loop-loss", c.graph.loop_loss_scale,
                    "Cauchy scale (sigmas) of the final robust solve (0: none)")
+      ->capture_default_str();
+  command->add_flag("--no-loop-refine", options->no_loop_refine,
+                    "use the RANSAC loop transform as it is (no ICP refinement of loops)");
+  command
+      ->add_option("--partner-neighbours", c.loop_refinement.partner_neighbours,
+                   "loop partner chosen among the matched submap and this many neighbours on each "
+                   "side (0: the matched submap)")
+      ->capture_default_str();
+  command
+      ->add_option("--loop-min-point-overlap", c.loop_refinement.min_point_overlap,
+                   "optional verification, off by default: drop matches whose point overlap with "
+                   "the loop partner is below this (0..1; correlates with the evaluated overlap)")
       ->capture_default_str();
   command->add_flag("--no-gate", options->no_gate,
                     "add every detected loop to the graph (no agreement test with the estimate)");

@@ -20,6 +20,7 @@ void Validate(const SlamConfig& config) {
   Validate(config.mapping);
   Validate(config.place);
   Validate(config.graph);
+  Validate(config.loop_refinement);
   auto fail = [](const std::string& field, const std::string& why) {
     throw std::invalid_argument("SlamConfig." + field + ": " + why);
   };
@@ -59,6 +60,17 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
   previous_icp_ = pose;
   have_previous_ = true;
   scans_.push_back({scan_index, scan.timestamp_s, pose, -1});
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const double range = scan.ranges_m[i];
+    if (scan.valid[i] == 0 || range < config_.loop_refinement.min_range_m ||
+        range >= config_.loop_refinement.max_range_m) {
+      continue;
+    }
+    points.push_back(scan.T_robot_laser * scan.Endpoint(i));
+  }
+  pending_points_.push_back(std::move(points));
   ++stats_.scans;
   map_.source_scans = stats_.scans;
   map_.source_keypoints += keypoints.size();
@@ -110,6 +122,13 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
   icp_origins_.push_back(icp_origin);
   icp_submap_poses_.push_back(submap.poses);
   origin_path_m_.push_back(origin_path);
+  {
+    std::vector<Pose2> T_submap_robot;
+    T_submap_robot.reserve(submap.poses.size());
+    for (const Pose2& p : submap.poses) T_submap_robot.push_back(Between(icp_origin, p));
+    clouds_.push_back(BuildSubmapCloud(pending_points_, T_submap_robot, config_.loop_refinement));
+    pending_points_.clear();
+  }
   // The submap's poses follow its (possibly corrected) node.
   const Pose2 node = graph_.node(id);
   for (Pose2& p : submap.poses) p = node * Between(icp_origin, p);
@@ -152,40 +171,19 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
     if (step.match.found) {
       LoopClosure loop;
       loop.query_submap = id;
-      loop.reference_submap = step.match.place_id;
-      loop.T_ref_cur = step.match.T_ref_cur;
+      loop.matched_submap = step.match.place_id;
+      loop.T_matched_cur_ransac = step.match.T_ref_cur;
       loop.pairs = step.match.pairs;
       loop.consensus = step.match.consensus;
       loop.gamma = step.match.gamma;
       loop.confidence = step.match.confidence;
-      loop.path_between_m = origin_path - origin_path_m_[loop.reference_submap];
-      const Pose2 predicted = Between(graph_.node(loop.reference_submap), graph_.node(id));
-      const Pose2 disagreement = Between(predicted, loop.T_ref_cur);
-      loop.gate_translation_m = TranslationNorm(disagreement);
-      loop.gate_rotation_rad = std::abs(disagreement.theta);
-      loop.accepted = config_.gate_base_m <= 0.0 ||
-                      (loop.gate_translation_m <=
-                           config_.gate_base_m + config_.gate_per_path * loop.path_between_m &&
-                       loop.gate_rotation_rad <=
-                           config_.gate_base_rad + config_.gate_per_path_rad * loop.path_between_m);
-      ++stats_.loops_detected;
-      if (loop.accepted) {
-        PoseGraphEdge edge;
-        edge.kind = PoseGraphEdge::Kind::kLoop;
-        edge.from = loop.reference_submap;
-        edge.to = id;
-        edge.T_from_to = loop.T_ref_cur;
-        const double scale = std::sqrt(static_cast<double>(config_.loop_reference_consensus) /
-                                       std::max(1, loop.consensus));
-        edge.sigma_x_m = edge.sigma_y_m = config_.loop_sigma_m * scale;
-        edge.sigma_theta_rad = config_.loop_sigma_rad * scale;
-        loop.edge = graph_.AddEdge(edge);
-        ++stats_.loops_accepted;
-        ++loops_since_optimization_;
-        dirty_ = true;
+      RefineAndChoosePartner(id, eligible, loop);
+      if (loop.point_overlap < config_.loop_refinement.min_point_overlap) {
+        ++stats_.loops_rejected_by_point_overlap;  // optional verification (off by default)
+      } else {
+        AddLoop(id, origin_path, loop);
+        step.loop = static_cast<int>(loops_.size()) - 1;
       }
-      step.loop = static_cast<int>(loops_.size());
-      loops_.push_back(loop);
     }
   }
   stats_.seconds_recognition += SecondsSince(start);
@@ -194,6 +192,67 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
     Optimize();
     step.optimized = true;
   }
+}
+
+void OnlineSlam::RefineAndChoosePartner(int id, std::size_t eligible, LoopClosure& loop) {
+  const LoopRefinementConfig& config = config_.loop_refinement;
+  const int matched = loop.matched_submap;
+  // Neighbours of the matched submap, nearest first, before and after it; eligible places only
+  // (never a recent neighbour of the current submap). The initial transform to a neighbour goes
+  // through the graph estimate of the two neighbours (odometry-accurate at this distance).
+  std::vector<LoopPartnerCandidate> candidates;
+  for (int offset = 1; offset <= config.partner_neighbours; ++offset) {
+    for (const int candidate : {matched - offset, matched + offset}) {
+      if (candidate < 0 || candidate >= static_cast<int>(eligible)) continue;
+      candidates.push_back({candidate, &clouds_[static_cast<std::size_t>(candidate)],
+                            Between(graph_.node(candidate), graph_.node(matched))});
+    }
+  }
+  const LoopPartnerChoice choice = ChooseLoopPartner(clouds_[static_cast<std::size_t>(id)], matched,
+                                                     clouds_[static_cast<std::size_t>(matched)],
+                                                     loop.T_matched_cur_ransac, candidates, config);
+  const LoopRefinement& best = choice.refinement;
+  loop.reference_submap = choice.partner;
+  loop.T_ref_cur = best.T_ref_cur;
+  loop.refined = best.refined;
+  loop.refine_status = best.status;
+  loop.refine_inlier_ratio_initial = best.inlier_ratio_initial;
+  loop.refine_inlier_ratio = best.inlier_ratio;
+  loop.refine_correction_m = best.correction_m;
+  loop.refine_correction_rad = best.correction_rad;
+  loop.point_overlap = best.overlap;
+}
+
+void OnlineSlam::AddLoop(int id, double origin_path, LoopClosure loop) {
+  loop.path_between_m = origin_path - origin_path_m_[loop.reference_submap];
+  const Pose2 predicted = Between(graph_.node(loop.reference_submap), graph_.node(id));
+  const Pose2 disagreement = Between(predicted, loop.T_ref_cur);
+  loop.gate_translation_m = TranslationNorm(disagreement);
+  loop.gate_rotation_rad = std::abs(disagreement.theta);
+  loop.accepted = config_.gate_base_m <= 0.0 ||
+                  (loop.gate_translation_m <=
+                       config_.gate_base_m + config_.gate_per_path * loop.path_between_m &&
+                   loop.gate_rotation_rad <=
+                       config_.gate_base_rad + config_.gate_per_path_rad * loop.path_between_m);
+  ++stats_.loops_detected;
+  if (loop.accepted) {
+    PoseGraphEdge edge;
+    edge.kind = PoseGraphEdge::Kind::kLoop;
+    edge.from = loop.reference_submap;
+    edge.to = id;
+    edge.T_from_to = loop.T_ref_cur;
+    const double scale = std::sqrt(static_cast<double>(config_.loop_reference_consensus) /
+                                   std::max(1, loop.consensus));
+    edge.sigma_x_m = edge.sigma_y_m = config_.loop_sigma_m * scale;
+    edge.sigma_theta_rad = config_.loop_sigma_rad * scale;
+    loop.edge = graph_.AddEdge(edge);
+    ++stats_.loops_accepted;
+    ++loops_since_optimization_;
+    dirty_ = true;
+  }
+  stats_.loops_refined += loop.refined ? 1 : 0;
+  stats_.loops_partner_changed += loop.reference_submap != loop.matched_submap ? 1 : 0;
+  loops_.push_back(loop);
 }
 
 void OnlineSlam::Optimize() {

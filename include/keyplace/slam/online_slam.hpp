@@ -2,13 +2,17 @@
 // Online SLAM with loop closure by place recognition (paper Section 6.2.2). Scans are eaten one
 // at a time: ICP scan odometry -> local mapping (Algorithm 1) -> each completed submap becomes a
 // node of an SE(2) pose graph (odometry edge to the previous submap) and is queried against the
-// submaps mapped so far, its recent neighbours excluded -> a verified, gated loop becomes a loop
-// edge -> the graph is optimised (Ceres, robust loop loss, outlier loops switched off) -> the
+// submaps mapped so far, its recent neighbours excluded -> a verified match is refined by ICP
+// between the submaps' point clouds and given the best-overlapping partner among the matched
+// submap and its neighbours (loop_refinement.hpp) -> a gated loop becomes a loop edge -> the
+// graph is optimised (Ceres, robust loop loss, outlier loops switched off) -> the
 // map's submap poses, and with them every scan's pose, follow the optimised submap origins.
 
 #include <cstddef>
 #include <memory>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/features/keypoint.hpp"
@@ -19,6 +23,7 @@
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
+#include "keyplace/slam/loop_refinement.hpp"
 #include "keyplace/slam/pose_graph.hpp"
 
 namespace keyplace {
@@ -28,6 +33,9 @@ struct SlamConfig {
   MappingConfig mapping;         // submaps (paper Table V)
   PlaceRecognitionConfig place;  // loop detection (paper Table V; our default preset)
   PoseGraphConfig graph;         // back end
+  // Dense ICP refinement of each detected loop and choice of its partner submap among the matched
+  // one and its temporal neighbours (docs/SLAM.md, "Loop refinement"). Runs before the gate.
+  LoopRefinementConfig loop_refinement;
 
   // --- which submaps a completed submap is matched with
   // Not with the last `exclude_recent_submaps` submaps before it, nor with submaps whose origin
@@ -72,9 +80,18 @@ void Validate(const SlamConfig& config);
 
 /// One detected loop (a `found` place match of a completed submap).
 struct LoopClosure {
-  int query_submap = 0;      // the completed submap (current)
-  int reference_submap = 0;  // the matched earlier submap
-  Pose2 T_ref_cur;           // the query's origin in the frame of the reference's origin
+  int query_submap = 0;        // the completed submap (current)
+  int reference_submap = 0;    // the loop partner: the matched submap or one of its neighbours
+  Pose2 T_ref_cur;             // the query's origin in the frame of the partner's origin (final)
+  int matched_submap = 0;      // the submap place recognition matched
+  Pose2 T_matched_cur_ransac;  // place recognition's (RANSAC) estimate against it
+  bool refined = false;        // T_ref_cur is the ICP refinement (else composed from RANSAC)
+  IcpStatus refine_status = IcpStatus::kTooFewPoints;  // of the ICP against the partner
+  double refine_inlier_ratio_initial = 0.0;  // current-cloud inliers at the initial estimate
+  double refine_inlier_ratio = 0.0;          // ... at T_ref_cur
+  double refine_correction_m = 0.0;          // ICP correction of the initial estimate
+  double refine_correction_rad = 0.0;
+  double point_overlap = 0.0;  // PointOverlap of the partner and current clouds at T_ref_cur
   int pairs = 0;
   int consensus = 0;
   double gamma = 0.0;
@@ -101,7 +118,12 @@ struct SlamStats {
   std::size_t submaps = 0;
   std::size_t queries = 0;  // completed submaps matched against the map (eligible places > 0)
   std::size_t loops_detected = 0;
-  std::size_t loops_accepted = 0;  // passed the gate
+  std::size_t loops_accepted = 0;         // passed the gate
+  std::size_t loops_refined = 0;          // loop transform refined by ICP
+  std::size_t loops_partner_changed = 0;  // partner is a neighbour of the matched submap
+  // Found matches not taken as loops by the optional point-overlap verification
+  // (loop_refinement.min_point_overlap; 0 by default, then always 0).
+  std::size_t loops_rejected_by_point_overlap = 0;
   std::size_t optimizations = 0;
   std::size_t solves = 0;
   std::size_t loops_rejected_by_graph = 0;  // switched off at the moment
@@ -148,6 +170,10 @@ class OnlineSlam {
 
  private:
   void CompleteSubmap(SlamStep& step);
+  // Refines a found match and chooses its partner; fills the loop's transform and partner.
+  void RefineAndChoosePartner(int id, std::size_t eligible, LoopClosure& loop);
+  // Gates the loop, adds its edge when accepted and records it.
+  void AddLoop(int id, double origin_path, LoopClosure loop);
   void Optimize();
   void ApplyGraph();
 
@@ -159,7 +185,10 @@ class OnlineSlam {
   std::vector<Pose2> icp_origins_;  // ICP T_world_robot of each submap's origin
   std::vector<std::vector<Pose2>> icp_submap_poses_;
   std::vector<double> origin_path_m_;  // travelled path at each submap origin
-  std::vector<Place> places_;          // one per completed submap (place frame = submap frame)
+  std::vector<SubmapCloud> clouds_;    // one per completed submap (loop refinement)
+  // Endpoints (robot frame, range-filtered) of the scans of the submap in progress.
+  std::vector<std::vector<Eigen::Vector2d>> pending_points_;
+  std::vector<Place> places_;  // one per completed submap (place frame = submap frame)
   std::unique_ptr<PlaceRecognizer> recognizer_;
   std::size_t recognizer_places_ = 0;  // prefix of places_ the recognizer holds
   std::vector<LoopClosure> loops_;
