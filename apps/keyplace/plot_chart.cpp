@@ -48,15 +48,17 @@ void DrawPanel(cairo_t* cr, const Chart& chart, double x0, double y0) {
   double max_y = max_x;
   for (const ChartSeries& s : chart.series) {
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      min_x = std::min(min_x, s.x[i]);
+      if (!std::isfinite(s.x[i])) continue;
+      min_x = std::min(min_x, s.x[i]);  // the x range covers points without a y value too
       max_x = std::max(max_x, s.x[i]);
+      if (!std::isfinite(s.y[i])) continue;
       min_y = std::min(min_y, s.y[i]);
       max_y = std::max(max_y, s.y[i]);
     }
   }
   const bool empty = min_x > max_x;
-  if (empty) min_x = 0, max_x = 1, min_y = 0, max_y = 1;
+  if (empty) min_x = 0, max_x = 1;
+  if (min_y > max_y) min_y = 0, max_y = 1;  // no y value at all
   if (min_y >= 0.0) min_y = 0.0;
   if (chart.y_min) min_y = *chart.y_min;
   if (chart.y_max) max_y = *chart.y_max;

@@ -255,9 +255,11 @@ std::string TableV() {
     const PaperParameter& p = parameters[k];
     const double value = k < ours.size() && ours[k] ? *ours[k] : 0.0;
     const bool same = std::abs(value - p.value) < 1e-9;
-    html += fmt::format("<tr><td>{}</td><td>{}</td><td>{:g}</td><td{}>{:g}</td><td>{}</td></tr>\n",
-                        HtmlEscape(p.name), HtmlEscape(p.source), p.value,
-                        same ? "" : " class=\"differs\"", value, HtmlEscape(p.meaning));
+    html += fmt::format(
+        "<tr><td>{}</td><td class=\"text\">{}</td><td>{:g}</td><td{}>{:g}</td><td "
+        "class=\"text\">{}</td></tr>\n",
+        HtmlEscape(p.name), HtmlEscape(p.source), p.value, same ? "" : " class=\"differs\"", value,
+        HtmlEscape(p.meaning));
   }
   html += "</tbody></table>\n";
   html += fmt::format(

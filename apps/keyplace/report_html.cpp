@@ -189,7 +189,7 @@ h2 { border-bottom: 1px solid #aaa; margin-top: 2em; }
 table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.92em; }
 th, td { border: 1px solid #bbb; padding: 3px 7px; text-align: right; vertical-align: top; }
 th { background: #eee; }
-td:first-child, th:first-child { text-align: left; }
+td:first-child, th:first-child, td.text { text-align: left; }
 table.compare td:nth-child(2) { text-align: left; }
 tr.paper td { background: #f6f6f6; color: #444; }
 tr.ours td:first-child { text-align: left; }
