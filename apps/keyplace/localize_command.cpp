@@ -368,16 +368,17 @@ void RunLocalize(const LocalizeOptions& options) {
     WriteFileAtomically(options.queries_path, [&](std::ostream& out) {
       out << "start_scan\tevaluated_scan\tscans\tverified\taccepted\tambiguous\tcorrect\t"
              "matched_submap\test_x\test_y\test_theta\ttrue_x\ttrue_y\ttrue_theta\tconsensus\t"
-             "gamma\tscore\tsecond_score\tconfidence\tcandidates\tseconds\n";
+             "gamma\tscore\tsecond_score\tconfidence\tcandidates\tseconds\treference_coverage\n";
       for (const QueryRecord& r : records) {
         const PlaceMatch& m = r.match;
         fmt::print(out,
                    "{}\t{}\t{}\t{:d}\t{:d}\t{:d}\t{:d}\t{}\t{:.4f}\t{:.4f}\t{:.5f}\t{:.4f}\t"
-                   "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\n",
+                   "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\t{:.4f}\n",
                    r.start_scan, r.evaluated_scan, r.scans, m.verified, m.found, m.ambiguous,
                    r.correct, m.place_id, m.estimated_pose.x, m.estimated_pose.y,
                    m.estimated_pose.theta, r.truth.x, r.truth.y, r.truth.theta, m.consensus,
-                   m.gamma, m.score, m.second_score, m.confidence, m.candidates, m.seconds);
+                   m.gamma, m.score, m.second_score, m.confidence, m.candidates, m.seconds,
+                   m.reference_coverage);
       }
     });
   }

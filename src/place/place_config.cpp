@@ -38,6 +38,7 @@ const ConfigFields<PlaceRecognitionConfig>& Fields() {
                {C::ConsensusCounting::kDistinctReference, "distinct_reference"}})
         .Double("min_gamma", &C::min_gamma)
         .Double("min_gamma_all_scans", &C::min_gamma_all_scans)
+        .Double("min_reference_coverage", &C::min_reference_coverage)
         .Double("double_match_m", &C::double_match_m)
         .Enum("gamma_counting", &C::gamma_counting,
               {{C::GammaCounting::kUniquePairs, "unique_pairs"},
@@ -97,6 +98,8 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");
   Require(config.min_gamma_all_scans >= 0.0 && config.min_gamma_all_scans <= 1.0,
           "min_gamma_all_scans", "must lie in [0, 1]");
+  Require(config.min_reference_coverage >= 0.0 && config.min_reference_coverage <= 1.0,
+          "min_reference_coverage", "must lie in [0, 1]");
   Require(config.double_match_m > 0.0, "double_match_m", "must be positive");
   Require(config.distinct_distance_m > 0.0, "distinct_distance_m", "must be positive");
   Require(config.distinct_angle_deg > 0.0, "distinct_angle_deg", "must be positive");

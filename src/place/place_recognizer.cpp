@@ -197,6 +197,38 @@ GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions
   return result;
 }
 
+double ReferenceCoverage(const std::vector<Eigen::Vector2d>& reference_positions,
+                         const std::vector<Eigen::Vector2d>& current_positions,
+                         const Pose2& T_ref_cur, double radius_m) {
+  Box reference_box;
+  Box current_box;
+  std::vector<Eigen::Vector2d> current_in_ref;
+  current_in_ref.reserve(current_positions.size());
+  for (const auto& p : reference_positions) reference_box.Add(p);
+  for (const auto& p : current_positions) {
+    current_in_ref.push_back(T_ref_cur * p);
+    current_box.Add(current_in_ref.back());
+  }
+  Box overlap;
+  overlap.min = reference_box.min.cwiseMax(current_box.min);
+  overlap.max = reference_box.max.cwiseMin(current_box.max);
+  if (overlap.min.x() > overlap.max.x() || overlap.min.y() > overlap.max.y()) return 0.0;
+  const double radius2 = radius_m * radius_m;
+  int inside = 0;
+  int hit = 0;
+  for (const auto& r : reference_positions) {
+    if (!overlap.Contains(r)) continue;
+    ++inside;
+    for (const auto& c : current_in_ref) {
+      if ((c - r).squaredNorm() <= radius2) {
+        ++hit;
+        break;
+      }
+    }
+  }
+  return inside > 0 ? static_cast<double>(hit) / inside : 0.0;
+}
+
 std::vector<int> MergeNearbyKeypoints(const std::vector<Eigen::Vector2d>& positions,
                                       double radius_m) {
   std::vector<int> kept;
@@ -364,12 +396,16 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
                      query.descriptors, estimate.T_ref_cur, config_.double_match_m,
                      config_.descriptor_match_chi2, config_.gamma_counting);
     if (gamma.gamma < min_gamma) continue;  // second check
+    const double coverage = ReferenceCoverage(*reference_positions, *match_positions,
+                                              estimate.T_ref_cur, config_.inlier_distance_m);
+    if (coverage < config_.min_reference_coverage) continue;  // third check (ours)
     CandidateResult result;
     result.place_index = candidate.place_index;
     result.pairs = static_cast<int>(candidate.pairs.size());
     result.mean_pair_distance = candidate.mean_distance;
     result.consensus = consensus;
     result.gamma = gamma.gamma;
+    result.reference_coverage = coverage;
     result.verified = true;
     result.T_ref_cur = estimate.T_ref_cur;
     result.estimated_pose = place.T_world_place * estimate.T_ref_cur * query.T_first_evaluated;
@@ -402,6 +438,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     match.pairs = best->pairs;
     match.consensus = best->consensus;
     match.gamma = best->gamma;
+    match.reference_coverage = best->reference_coverage;
     match.score = best->score;
     match.second_score = second;
     const double consensus_factor =

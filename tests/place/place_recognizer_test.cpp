@@ -272,6 +272,42 @@ TEST(Gamma, ByHandOnASmallCase) {
             0.0);
 }
 
+TEST(ReferenceCoverage, ByHandOnTheGammaCase) {
+  // Same boxes as above: the reference keypoints inside the overlap are (0,0) and (1,0); the
+  // nearest current keypoints lie 0.02 m and 0.03 m away (descriptors do not matter here).
+  const std::vector<Eigen::Vector2d> reference = {{0, 0}, {1, 0}, {0, 1}, {3, 3}, {2, -0.5}};
+  const std::vector<Eigen::Vector2d> current_ref = {
+      {0.02, 0}, {1, 0.03}, {0.5, 0.5}, {-1, -1}, {1.5, -1}};
+  const Pose2 T_ref_cur(0.7, -2.0, 1.3);
+  std::vector<Eigen::Vector2d> current;
+  for (const auto& p : current_ref) current.push_back(T_ref_cur.inverse() * p);
+  EXPECT_NEAR(ReferenceCoverage(reference, current, T_ref_cur, 0.1), 1.0, 1e-12);
+  EXPECT_NEAR(ReferenceCoverage(reference, current, T_ref_cur, 0.025), 0.5, 1e-12);
+  EXPECT_EQ(ReferenceCoverage(reference, current, T_ref_cur, 0.01), 0.0);
+  // Disjoint boxes: nothing to cover.
+  EXPECT_EQ(ReferenceCoverage(reference, current, Pose2(100.0, 0.0, 0.0) * T_ref_cur, 0.1), 0.0);
+}
+
+TEST(PlaceRecognizer, ReferenceCoverageCheckRejectsPartialMatches) {
+  // The query re-observes 13 of the place's 25 keypoints (plus 8 random ones): consensus and
+  // gamma pass, but about half of the reference keypoints in the overlap stay uncovered.
+  const std::vector<Place> places = MakePlaces(10, 25, 5);
+  const PlaceQuery query = MakeQuery(places[3], Pose2(0.4, 0.3, -0.2), 12, 8, 77);
+  PlaceRecognitionConfig config = PlacePreset("default");
+  const PlaceMatch open = PlaceRecognizer(places, config).Recognize(query);
+  ASSERT_TRUE(open.found);
+  EXPECT_EQ(open.place_id, 3);
+  EXPECT_GT(open.reference_coverage, 0.4);
+  EXPECT_LT(open.reference_coverage, 0.8);
+  config.min_reference_coverage = 0.9;
+  EXPECT_FALSE(PlaceRecognizer(places, config).Recognize(query).verified);
+  // A full re-observation covers every reference keypoint in the overlap.
+  const PlaceMatch full =
+      PlaceRecognizer(places, config).Recognize(MakeQuery(places[3], Pose2(), 0, 8, 78));
+  ASSERT_TRUE(full.found);
+  EXPECT_DOUBLE_EQ(full.reference_coverage, 1.0);
+}
+
 TEST(DescriptorPairs, EachKeypointUsedOnce) {
   BetaGridDescriptor a = Descriptor(1);
   BetaGridDescriptor a2 = a;

@@ -47,6 +47,11 @@ struct PlaceRecognitionConfig {
   // paper.
   int verification_neighbours = 1;
   int min_consensus = 9;  // first check: RANSAC inliers
+  // Third check (beyond the paper; 0 = off): the fraction of the reference keypoints inside the
+  // overlap box that a verified query keypoint hits within inlier_distance_m. Stable keypoints
+  // are the ones that reappear, so a true revisit re-observes most of them, while a chance
+  // alignment of ~100 query keypoints hits a few (docs/PLACE.md, "Reference coverage").
+  double min_reference_coverage = 0.0;
   // How the consensus is counted. kQueryKeypoints: query keypoints with a reference keypoint
   // within inlier_distance_m (the paper). kDistinctReference: distinct reference keypoints hit by
   // those inliers (several query keypoints on one reference keypoint count once).

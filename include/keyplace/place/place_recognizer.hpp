@@ -79,6 +79,13 @@ GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions
                          const Pose2& T_ref_cur, double lambda_m, double chi2_threshold,
                          PlaceRecognitionConfig::GammaCounting counting);
 
+/// The fraction of the reference keypoints inside the overlap box (as for gamma: the intersection
+/// of both keypoint bounding boxes, the current keypoints mapped by T_ref_cur) that have a mapped
+/// current keypoint within `radius_m`. 0 when the overlap holds no reference keypoint.
+double ReferenceCoverage(const std::vector<Eigen::Vector2d>& reference_positions,
+                         const std::vector<Eigen::Vector2d>& current_positions,
+                         const Pose2& T_ref_cur, double radius_m);
+
 /// One candidate place that went through RANSAC.
 struct CandidateResult {
   int place_index = -1;
@@ -86,7 +93,8 @@ struct CandidateResult {
   double mean_pair_distance = 0.0;
   int consensus = 0;
   double gamma = 0.0;
-  bool verified = false;  // passed both checks
+  double reference_coverage = 0.0;  // see ReferenceCoverage, with the RANSAC query keypoints
+  bool verified = false;            // passed all checks
   Pose2 T_ref_cur;
   Pose2 estimated_pose;  // Eq. (9)
   double score = 0.0;    // selection score (PlaceRecognitionConfig::score), verified only
@@ -107,6 +115,7 @@ struct PlaceMatch {
   int pairs = 0;
   int consensus = 0;
   double gamma = 0.0;
+  double reference_coverage = 0.0;
   double score = 0.0;
   double second_score = 0.0;  // best distinct verified candidate (0 if none)
   // In [0, 1]: min(1, consensus / confidence_consensus) * gamma * (1 - second_score / score).
