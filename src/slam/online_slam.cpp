@@ -177,7 +177,9 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
       loop.consensus = step.match.consensus;
       loop.gamma = step.match.gamma;
       loop.confidence = step.match.confidence;
+      const auto refine_start = std::chrono::steady_clock::now();
       RefineAndChoosePartner(id, eligible, loop);
+      stats_.seconds_loop_refinement += SecondsSince(refine_start);
       if (loop.point_overlap < config_.loop_refinement.min_point_overlap) {
         ++stats_.loops_rejected_by_point_overlap;  // optional verification (off by default)
       } else {

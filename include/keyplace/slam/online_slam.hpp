@@ -129,7 +129,8 @@ struct SlamStats {
   std::size_t loops_rejected_by_graph = 0;  // switched off at the moment
   double seconds_odometry = 0.0;
   double seconds_mapping = 0.0;
-  double seconds_recognition = 0.0;
+  double seconds_recognition = 0.0;      // place recognition and loop refinement
+  double seconds_loop_refinement = 0.0;  // of which: ICP refinement and partner choice
   double seconds_optimization = 0.0;
 };
 
