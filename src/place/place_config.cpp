@@ -72,7 +72,8 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.verification_neighbours = 0;
   config.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
   config.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints;
-  config.min_gamma_all_scans = 0.4;  // unused: stable query keypoints
+  config.min_gamma_all_scans = 0.4;     // unused: stable query keypoints
+  config.min_reference_coverage = 0.0;  // unused: stable query keypoints
   return config;
 }
 

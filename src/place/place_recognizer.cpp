@@ -297,8 +297,9 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     match_descriptors = &merged_descriptors;
   }
 
-  const double min_gamma =
-      match_positions == &query.positions ? config_.min_gamma : config_.min_gamma_all_scans;
+  const bool all_scan_query = match_positions != &query.positions;
+  const double min_gamma = all_scan_query ? config_.min_gamma_all_scans : config_.min_gamma;
+  const double min_coverage = all_scan_query ? config_.min_reference_coverage : 0.0;
 
   // Algorithm 3 against every place: candidates with >= mu unique pairs.
   struct Candidate {
@@ -398,7 +399,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     if (gamma.gamma < min_gamma) continue;  // second check
     const double coverage = ReferenceCoverage(*reference_positions, *match_positions,
                                               estimate.T_ref_cur, config_.inlier_distance_m);
-    if (coverage < config_.min_reference_coverage) continue;  // third check (ours)
+    if (coverage < min_coverage) continue;  // third check (ours)
     CandidateResult result;
     result.place_index = candidate.place_index;
     result.pairs = static_cast<int>(candidate.pairs.size());

@@ -291,9 +291,18 @@ TEST(ReferenceCoverage, ByHandOnTheGammaCase) {
 TEST(PlaceRecognizer, ReferenceCoverageCheckRejectsPartialMatches) {
   // The query re-observes 13 of the place's 25 keypoints (plus 8 random ones): consensus and
   // gamma pass, but about half of the reference keypoints in the overlap stay uncovered.
+  // The check applies to queries verified with their all-scan keypoints.
   const std::vector<Place> places = MakePlaces(10, 25, 5);
-  const PlaceQuery query = MakeQuery(places[3], Pose2(0.4, 0.3, -0.2), 12, 8, 77);
+  const auto with_all_scan_keypoints = [](PlaceQuery query) {
+    query.all_positions = query.positions;
+    query.all_descriptors = query.descriptors;
+    return query;
+  };
+  const PlaceQuery stable_only = MakeQuery(places[3], Pose2(0.4, 0.3, -0.2), 12, 8, 77);
+  const PlaceQuery query = with_all_scan_keypoints(stable_only);
   PlaceRecognitionConfig config = PlacePreset("default");
+  EXPECT_EQ(config.min_reference_coverage, 0.5);
+  config.min_reference_coverage = 0.0;
   const PlaceMatch open = PlaceRecognizer(places, config).Recognize(query);
   ASSERT_TRUE(open.found);
   EXPECT_EQ(open.place_id, 3);
@@ -301,9 +310,12 @@ TEST(PlaceRecognizer, ReferenceCoverageCheckRejectsPartialMatches) {
   EXPECT_LT(open.reference_coverage, 0.8);
   config.min_reference_coverage = 0.9;
   EXPECT_FALSE(PlaceRecognizer(places, config).Recognize(query).verified);
+  // A stable-keypoint query is not checked.
+  EXPECT_TRUE(PlaceRecognizer(places, config).Recognize(stable_only).found);
   // A full re-observation covers every reference keypoint in the overlap.
   const PlaceMatch full =
-      PlaceRecognizer(places, config).Recognize(MakeQuery(places[3], Pose2(), 0, 8, 78));
+      PlaceRecognizer(places, config)
+          .Recognize(with_all_scan_keypoints(MakeQuery(places[3], Pose2(), 0, 8, 78)));
   ASSERT_TRUE(full.found);
   EXPECT_DOUBLE_EQ(full.reference_coverage, 1.0);
 }

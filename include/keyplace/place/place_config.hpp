@@ -47,11 +47,13 @@ struct PlaceRecognitionConfig {
   // paper.
   int verification_neighbours = 1;
   int min_consensus = 9;  // first check: RANSAC inliers
-  // Third check (beyond the paper; 0 = off): the fraction of the reference keypoints inside the
-  // overlap box that a verified query keypoint hits within inlier_distance_m. Stable keypoints
-  // are the ones that reappear, so a true revisit re-observes most of them, while a chance
-  // alignment of ~100 query keypoints hits a few (docs/PLACE.md, "Reference coverage").
-  double min_reference_coverage = 0.0;
+  // Third check (beyond the paper; 0 = off), for queries verified with their all-scan keypoints
+  // only: the fraction of the reference keypoints inside the overlap box that a verified query
+  // keypoint hits within inlier_distance_m. Stable keypoints are the ones that reappear, so a
+  // true revisit re-observes most of them, while a chance alignment of ~100 query keypoints hits
+  // a few. A stable-keypoint query (SLAM, paper preset) sees too little of the reference for
+  // this to mean anything and is not checked (docs/PLACE.md, "Reference coverage").
+  double min_reference_coverage = 0.5;
   // How the consensus is counted. kQueryKeypoints: query keypoints with a reference keypoint
   // within inlier_distance_m (the paper). kDistinctReference: distinct reference keypoints hit by
   // those inliers (several query keypoints on one reference keypoint count once).
