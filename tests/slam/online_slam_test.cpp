@@ -153,6 +153,24 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   EXPECT_GE(used, 1u) << slam.loops().size() << " loops detected";
   EXPECT_GT(before, 2.0);
   EXPECT_LT(after, 1.0) << "before " << before;
+  // Every loop is refined, and its transform (partner frame) matches the true relative pose of
+  // the two submaps' first scans; the RANSAC estimate against the matched submap is worse.
+  double refined_error_sum = 0.0, ransac_error_sum = 0.0;
+  for (const LoopClosure& loop : slam.loops()) {
+    const Submap& ref = slam.map().submaps[loop.reference_submap];
+    const Submap& matched = slam.map().submaps[loop.matched_submap];
+    const Submap& cur = slam.map().submaps[loop.query_submap];
+    EXPECT_TRUE(loop.refined);
+    EXPECT_LE(std::abs(loop.reference_submap - loop.matched_submap), 3);
+    const Pose2 truth = Between(run.truth[ref.first_scan()], run.truth[cur.first_scan()]);
+    const Pose2 truth_matched =
+        Between(run.truth[matched.first_scan()], run.truth[cur.first_scan()]);
+    const double error = TranslationNorm(Between(truth, loop.T_ref_cur));
+    EXPECT_LT(error, 0.05) << "loop " << loop.query_submap << " -> " << loop.reference_submap;
+    refined_error_sum += error;
+    ransac_error_sum += TranslationNorm(Between(truth_matched, loop.T_matched_cur_ransac));
+  }
+  EXPECT_LT(refined_error_sum, ransac_error_sum);
   // Every submap pose follows its node.
   for (const Submap& submap : slam.map().submaps) {
     const Pose2 node = slam.graph().node(submap.id);
