@@ -35,7 +35,8 @@ std::vector<Segment> SquareCorridorWorld() {
   for (int side = 0; side < 4; ++side) {
     const double c = std::cos(side * M_PI / 2), s = std::sin(side * M_PI / 2);
     for (double wall : {-7.6, -4.9}) {  // outer wall (inside) and inner wall (outside)
-      for (double u = -6.5; u < 6.5; u += gap(rng)) {
+      double u = -6.5;
+      while (u < 6.5) {
         const double w = size(rng), h = size(rng), a = turn(rng);
         std::vector<Eigen::Vector2d> box;
         for (const auto& corner : {Eigen::Vector2d(-w / 2, -h / 2), Eigen::Vector2d(w / 2, -h / 2),
@@ -46,6 +47,7 @@ std::vector<Segment> SquareCorridorWorld() {
         }
         const std::vector<Segment> box_segments = Polygon(box);
         world.insert(world.end(), box_segments.begin(), box_segments.end());
+        u += gap(rng);
       }
     }
   }
