@@ -479,9 +479,10 @@ void RegisterLocalizeCommand(CLI::App& app) {
                       "Accept only answers with at least this confidence (0..1)");
   command
       ->add_option("--preset", options->preset,
-                   "default (all candidates verified, best score, ambiguity rejection) or paper "
-                   "(first verified candidate, FLIRTLib RANSAC)")
-      ->check(CLI::IsMember({"default", "paper"}))
+                   "default (all candidates verified, best score, ambiguity rejection), paper "
+                   "(first verified candidate, FLIRTLib RANSAC) or strict (default plus the "
+                   "reference-coverage check, for maps recorded on another day)")
+      ->check(CLI::IsMember({"default", "paper", "strict"}))
       ->capture_default_str();
   command->add_option("--set", options->assignments,
                       "Override a PlaceRecognitionConfig field, KEY=VALUE (repeatable)");

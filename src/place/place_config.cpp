@@ -77,11 +77,18 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   return config;
 }
 
+PlaceRecognitionConfig StrictPlaceConfig() {
+  PlaceRecognitionConfig config;
+  config.min_reference_coverage = 0.5;
+  return config;
+}
+
 PlaceRecognitionConfig PlacePreset(const std::string& name) {
   if (name == "default") return PlaceRecognitionConfig{};
   if (name == "paper") return PaperPlaceConfig();
+  if (name == "strict") return StrictPlaceConfig();
   throw std::invalid_argument("unknown place recognition preset '" + name +
-                              "' (expected default or paper)");
+                              "' (expected default, paper or strict)");
 }
 
 void Validate(const PlaceRecognitionConfig& config) {

@@ -301,7 +301,8 @@ TEST(PlaceRecognizer, ReferenceCoverageCheckRejectsPartialMatches) {
   const PlaceQuery stable_only = MakeQuery(places[3], Pose2(0.4, 0.3, -0.2), 12, 8, 77);
   const PlaceQuery query = with_all_scan_keypoints(stable_only);
   PlaceRecognitionConfig config = PlacePreset("default");
-  EXPECT_EQ(config.min_reference_coverage, 0.5);
+  EXPECT_EQ(config.min_reference_coverage, 0.0);
+  EXPECT_EQ(PlacePreset("strict").min_reference_coverage, 0.5);
   config.min_reference_coverage = 0.0;
   const PlaceMatch open = PlaceRecognizer(places, config).Recognize(query);
   ASSERT_TRUE(open.found);
