@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <tuple>
 
 #include "keyplace/place/ransac.hpp"
@@ -30,6 +31,33 @@ struct Box {
     return p.x() >= min.x() && p.x() <= max.x() && p.y() >= min.y() && p.y() <= max.y();
   }
 };
+
+// The current keypoints mapped into the reference frame, and the overlap area of Eq. (10): the
+// intersection of both keypoint bounding boxes (empty: nullopt).
+struct MappedOverlap {
+  std::vector<Eigen::Vector2d> current_in_ref;
+  std::optional<Box> overlap;
+};
+MappedOverlap MapAndOverlap(const std::vector<Eigen::Vector2d>& reference_positions,
+                            const std::vector<Eigen::Vector2d>& current_positions,
+                            const Pose2& T_ref_cur) {
+  MappedOverlap result;
+  result.current_in_ref.reserve(current_positions.size());
+  Box reference_box;
+  Box current_box;
+  for (const auto& p : reference_positions) reference_box.Add(p);
+  for (const auto& p : current_positions) {
+    result.current_in_ref.push_back(T_ref_cur * p);
+    current_box.Add(result.current_in_ref.back());
+  }
+  Box overlap;
+  overlap.min = reference_box.min.cwiseMax(current_box.min);
+  overlap.max = reference_box.max.cwiseMin(current_box.max);
+  if (overlap.min.x() <= overlap.max.x() && overlap.min.y() <= overlap.max.y()) {
+    result.overlap = overlap;
+  }
+  return result;
+}
 
 double SelectionScore(PlaceRecognitionConfig::Score score, int consensus, double gamma) {
   switch (score) {
@@ -130,19 +158,10 @@ GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions
                          const Pose2& T_ref_cur, double lambda_m, double chi2_threshold,
                          PlaceRecognitionConfig::GammaCounting counting) {
   GammaResult result;
-  std::vector<Eigen::Vector2d> current_in_ref;
-  current_in_ref.reserve(current_positions.size());
-  Box reference_box;
-  Box current_box;
-  for (const auto& p : reference_positions) reference_box.Add(p);
-  for (const auto& p : current_positions) {
-    current_in_ref.push_back(T_ref_cur * p);
-    current_box.Add(current_in_ref.back());
-  }
-  Box overlap;
-  overlap.min = reference_box.min.cwiseMax(current_box.min);
-  overlap.max = reference_box.max.cwiseMin(current_box.max);
-  if (overlap.min.x() > overlap.max.x() || overlap.min.y() > overlap.max.y()) return result;
+  const auto [current_in_ref, maybe_overlap] =
+      MapAndOverlap(reference_positions, current_positions, T_ref_cur);
+  if (!maybe_overlap) return result;
+  const Box& overlap = *maybe_overlap;
 
   std::vector<int> reference_inside;
   std::vector<int> current_inside;
@@ -200,19 +219,10 @@ GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions
 double ReferenceCoverage(const std::vector<Eigen::Vector2d>& reference_positions,
                          const std::vector<Eigen::Vector2d>& current_positions,
                          const Pose2& T_ref_cur, double radius_m) {
-  Box reference_box;
-  Box current_box;
-  std::vector<Eigen::Vector2d> current_in_ref;
-  current_in_ref.reserve(current_positions.size());
-  for (const auto& p : reference_positions) reference_box.Add(p);
-  for (const auto& p : current_positions) {
-    current_in_ref.push_back(T_ref_cur * p);
-    current_box.Add(current_in_ref.back());
-  }
-  Box overlap;
-  overlap.min = reference_box.min.cwiseMax(current_box.min);
-  overlap.max = reference_box.max.cwiseMin(current_box.max);
-  if (overlap.min.x() > overlap.max.x() || overlap.min.y() > overlap.max.y()) return 0.0;
+  const auto [current_in_ref, maybe_overlap] =
+      MapAndOverlap(reference_positions, current_positions, T_ref_cur);
+  if (!maybe_overlap) return 0.0;
+  const Box& overlap = *maybe_overlap;
   const double radius2 = radius_m * radius_m;
   int inside = 0;
   int hit = 0;
