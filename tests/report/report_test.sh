@@ -34,7 +34,11 @@ if "${run[@]}" --out "$out" >"$work/first.txt" 2>&1; then ok; else
 fi
 page=$out/index.html
 [ -s "$page" ] && ok || fail "no $page"
-expect '^\[1/20\] map-fr079 ' "$work/first.txt" "progress lines"
+expect '^\[1/[0-9]*\] map-fr079 ' "$work/first.txt" "progress lines"
+# What the first run did, to compare the rerun with (the plan's size is not fixed here).
+ran=$(grep -c '^    done in ' "$work/first.txt")
+skipped=$(grep -c ': skipped, needs ' "$work/first.txt")
+[ "$ran" -ge 10 ] && ok || fail "expected at least 10 steps to run, $ran ran"
 expect 'report written to' "$work/first.txt" "summary line"
 
 # Every table and figure section.
@@ -69,13 +73,13 @@ if grep -q '<h2>Warnings' "$page"; then fail "the page has warnings"; else ok; f
 
 # A rerun reuses everything.
 if "${run[@]}" --out "$out" >"$work/second.txt" 2>&1; then ok; else fail "second run"; fi
-expect 'Steps: 0 ran, 10 reused, 10 skipped, 0 failed' "$page" "rerun reuses the 10 artefacts"
+expect "Steps: 0 ran, $ran reused, $skipped skipped, 0 failed" "$page" "rerun reuses the $ran artefacts"
 if grep -q '^    keyplace ' "$work/second.txt"; then fail "the rerun ran a command"; else ok; fi
 
 # --no-run renders from an existing work directory into another page.
 if "$keyplace" report --out "$work/norun" --work "$out/work" --data "$work/data" --datasets fr079 \
     --quick --no-run >"$work/norun.txt" 2>&1; then ok; else fail "--no-run"; fi
-expect 'Steps: 0 ran, 10 reused' "$work/norun/index.html" "--no-run page"
+expect "Steps: 0 ran, $ran reused" "$work/norun/index.html" "--no-run page"
 # (without --threads: the thread count is no part of a step's identity)
 
 # Errors name the culprit.
