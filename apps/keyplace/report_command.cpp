@@ -369,12 +369,16 @@ std::string TableX(const ReportContext& context) {
     if (const PaperPglPcl* p = PaperTableX(f.name, "tip-flirt", 0, 0.0)) {
       tip.paper = {p->p_gl, p->p_cl, 0.0};
     }
-    const std::string path = A::TipFlirt(context.settings, base);
-    tip.ours.push_back(
-        Row(context, "keyplace <code>--baseline tip-flirt</code>", path, [&](const auto& j) {
-          return std::vector<std::optional<double>>{Number(j, "p_gl", path),
-                                                    Number(j, "p_cl", path), 0.0};
-        }));
+    for (const int mu : {10, 5}) {
+      const std::string path = A::TipFlirt(context.settings, base, mu);
+      const std::string label =
+          mu == 10 ? "keyplace <code>--baseline tip-flirt</code>"
+                   : "keyplace <code>--baseline tip-flirt --mu 5 --set min_consensus=5</code>";
+      tip.ours.push_back(Row(context, label, path, [&](const auto& j) {
+        return std::vector<std::optional<double>>{Number(j, "p_gl", path), Number(j, "p_cl", path),
+                                                  0.0};
+      }));
+    }
     groups.push_back(std::move(tip));
   }
   return ComparisonTableHtml(

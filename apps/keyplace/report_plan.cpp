@@ -148,8 +148,9 @@ std::string ReportArtefacts::Localize(const ReportSettings& s, const std::string
   return Join(s.work_dir, fmt::format("localize/{}{}-{}-mu{}-lambda{}.json", base,
                                       raw ? "-raw" : "", preset, mu, LambdaText(lambda_m)));
 }
-std::string ReportArtefacts::TipFlirt(const ReportSettings& s, const std::string& base) {
-  return Join(s.work_dir, "localize/" + base + "-tip-flirt.json");
+std::string ReportArtefacts::TipFlirt(const ReportSettings& s, const std::string& base, int mu) {
+  return Join(s.work_dir, "localize/" + base + "-tip-flirt" +
+                              (mu == 10 ? "" : fmt::format("-mu{}", mu)) + ".json");
 }
 std::string ReportArtefacts::Fig8Dir(const ReportSettings& s, const std::string& base) {
   return Join(s.work_dir, "sweeps/fig8-" + base);
@@ -230,10 +231,16 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
     if (base != "fr101") {
       steps.push_back({"localize-" + base + "-tip-flirt",
                        "Table X, TIP-FLIRT baseline, " + f.name,
-                       {"localize", "--baseline", "tip-flirt", "--log", log, "--preset", "paper",
-                        "--n-pos", n_pos, "--json", A::TipFlirt(s, base)},
+                       {"localize", "--baseline", "tip-flirt", "--log", log, "--n-pos", n_pos,
+                        "--json", A::TipFlirt(s, base)},
                        {log},
                        {A::TipFlirt(s, base)}});
+      steps.push_back({"localize-" + base + "-tip-flirt-mu5",
+                       "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
+                       {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
+                        "min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
+                       {log},
+                       {A::TipFlirt(s, base, 5)}});
     }
     // Figure 8: mapping criteria over s_min x l_g.
     const std::string fig8 = A::Fig8Dir(s, base);

@@ -37,7 +37,9 @@ struct ReportArtefacts {
   /// localize JSON; `raw` queries from the raw log; preset "default" | "paper".
   static std::string Localize(const ReportSettings& s, const std::string& base, bool raw,
                               const std::string& preset, double lambda_m, int mu);
-  static std::string TipFlirt(const ReportSettings& s, const std::string& base);
+  /// `mu` 10: the baseline's defaults (mu 10, consensus 9); 5: mu 5 and consensus 5, the setting
+  /// that reproduces Tipaldi et al.'s figures (docs/PLACE.md).
+  static std::string TipFlirt(const ReportSettings& s, const std::string& base, int mu = 10);
   static std::string Fig8Dir(const ReportSettings& s, const std::string& base);
   static std::string Fig9Dir(const ReportSettings& s, const std::string& base,
                              const std::string& preset);
