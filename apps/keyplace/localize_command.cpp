@@ -353,8 +353,9 @@ void RunLocalize(const LocalizeOptions& options) {
   fmt::print("\n{:<18} {:>9} {:>7} {:>7} {:>9}\n", dataset_name.empty() ? "" : dataset_name,
              "Precision", "Recall", "#Scans", "Time (s)");
   if (paper) {
-    fmt::print("  paper (Tab. {:<4}) {:9.2f} {:7.2f} {:7.2f} {:9.3f}\n", paper->table,
-               paper->precision, paper->recall, paper->scans, paper->seconds);
+    fmt::print("  {:<18}{:9.2f} {:7.2f} {:7.2f} {:9.3f}\n",
+               fmt::format("paper (Tab. {})", paper->table), paper->precision, paper->recall,
+               paper->scans, paper->seconds);
   }
   fmt::print("  keyplace         {:9.3f} {:7.3f} {:7.2f} {:9.4f}\n", precision, recall, scans_mean,
              seconds_mean);
