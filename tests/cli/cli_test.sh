@@ -5,37 +5,8 @@ set -uo pipefail
 keyplace=$1
 source_dir=$2
 log="$source_dir/data/fr079-corrected.log.gz"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-
-check() {  # check NAME COMMAND...: the command must succeed
-  local name=$1
-  shift
-  if "$@" >"$work/out" 2>"$work/err"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAILED: $name"
-    sed 's/^/  | /' "$work/out" "$work/err" | head -20
-  fi
-}
-
-fails_with() {  # fails_with NAME FRAGMENT COMMAND...: must fail, stderr containing FRAGMENT
-  local name=$1 fragment=$2
-  shift 2
-  if "$@" >"$work/out" 2>"$work/err"; then
-    failed=$((failed + 1))
-    echo "FAILED: $name (succeeded, expected an error)"
-  elif grep -qF -- "$fragment" "$work/err"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAILED: $name (error does not mention '$fragment')"
-    sed 's/^/  | /' "$work/err" | head -10
-  fi
-}
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
 
 json_value() {  # json_value FILE KEY: a top-level number or string of a JSON file
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"
@@ -105,5 +76,4 @@ echo precious >"$work/keep.json"
 "$keyplace" features "$work/bad.log" --json "$work/keep.json" >/dev/null 2>&1
 check "output kept on failure" test "$(cat "$work/keep.json")" = precious
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish cli_test

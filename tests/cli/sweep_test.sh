@@ -7,16 +7,8 @@ set -uo pipefail
 keyplace=$1
 source_dir=$2
 log="$source_dir/data/fr079-corrected.log.gz"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-
-ok() { passed=$((passed + 1)); }
-fail() {
-  failed=$((failed + 1))
-  echo "FAILED: $1"
-}
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
 
 # The table without the timing column (the last one), rows sorted: what must not depend on
 # interruptions, thread count or completion order.
@@ -103,5 +95,4 @@ for bad in "0:1" "0:1:0" "1:0:0.1" "0.1,x" "" "0.1,0.1"; do
   fi
 done
 
-echo "sweep_test: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish sweep_test

@@ -7,15 +7,8 @@ set -uo pipefail
 source_dir=$1
 report=$2
 check="$source_dir/scripts/check-report.sh"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-fail() {
-  failed=$((failed + 1))
-  echo "FAILED: $1"
-}
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
 
 if [ ! -s "$report/index.html" ]; then
   echo "chromium_test: $report/index.html missing (the cli.report test makes it)"
@@ -77,5 +70,4 @@ fi
 # Usage errors.
 if bash "$check" "$work/nothing-here" >/dev/null 2>&1; then fail "a missing page passed"; else ok; fi
 
-echo "chromium_test: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish chromium_test

@@ -8,17 +8,10 @@
 set -uo pipefail
 keyplace=$1
 source_dir=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
 out=${3:-$work/report}
 rm -rf "$out"
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-fail() {
-  failed=$((failed + 1))
-  echo "FAILED: $1"
-}
 expect() {  # expect PATTERN FILE DESCRIPTION
   if grep -q -- "$1" "$2"; then ok; else fail "$3 (no '$1' in $2)"; fi
 }
@@ -97,5 +90,4 @@ else
   expect 'maps/fr079.json: not valid JSON' "$work/broken.txt" "corrupt artefact message"
 fi
 
-echo "report_test: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish report_test
