@@ -252,24 +252,21 @@ StabilityFigureSummary DrawStabilityFigures(const std::string& log_path, std::si
       cairo_stroke(cr);
     }
     cairo_set_line_width(cr, 0.8);
-    for (std::size_t k = 0; k < scan_i.keypoints.size(); ++k) {
-      const Eigen::Vector2d q = va.Px(scan_i.keypoints[k]);
-      cairo_set_source_rgba(cr, 0.1, 0.3, 0.9, 0.5);
-      cairo_arc(cr, q.x(), q.y(), scan_i.scales[k] * va.scale, 0, 2 * M_PI);
-      cairo_stroke(cr);
-      cairo_set_source_rgb(cr, 0.1, 0.3, 0.9);
-      Triangle(cr, q, 6.0);
-      cairo_fill(cr);
-    }
-    for (std::size_t k = 0; k < scan_j.keypoints.size(); ++k) {
-      const Eigen::Vector2d q = va.Px(scan_j.keypoints[k]);
-      cairo_set_source_rgba(cr, 0.9, 0.15, 0.1, 0.5);
-      cairo_arc(cr, q.x(), q.y(), scan_j.scales[k] * va.scale, 0, 2 * M_PI);
-      cairo_stroke(cr);
-      cairo_set_source_rgb(cr, 0.9, 0.15, 0.1);
-      Star(cr, q, 6.0);
-      cairo_fill(cr);
-    }
+    // Each keypoint: its support circle (the scale) and a marker.
+    const auto draw_keypoints = [&](const ScanView& scan, double r, double g, double b,
+                                    void (*marker)(cairo_t*, const Eigen::Vector2d&, double)) {
+      for (std::size_t k = 0; k < scan.keypoints.size(); ++k) {
+        const Eigen::Vector2d q = va.Px(scan.keypoints[k]);
+        cairo_set_source_rgba(cr, r, g, b, 0.5);
+        cairo_arc(cr, q.x(), q.y(), scan.scales[k] * va.scale, 0, 2 * M_PI);
+        cairo_stroke(cr);
+        cairo_set_source_rgb(cr, r, g, b);
+        marker(cr, q, 6.0);
+        cairo_fill(cr);
+      }
+    };
+    draw_keypoints(scan_i, 0.1, 0.3, 0.9, Triangle);
+    draw_keypoints(scan_j, 0.9, 0.15, 0.1, Star);
     for (const auto& [local, colour] : {std::pair{i_local, 0}, std::pair{j_local, 1}}) {
       const Eigen::Vector2d q = va.Px(laser_in_submap(local).translation());
       if (colour == 0) {
