@@ -14,7 +14,55 @@ std::uint64_t Key(std::int64_t i, std::int64_t j) {
          static_cast<std::uint32_t>(j);
 }
 
+using CellSet = std::unordered_set<std::uint64_t>;
+
+CellSet CellsOf(const OccupancySummary& summary) {
+  CellSet cells;
+  cells.reserve(summary.cells.size() * 2);
+  for (const Eigen::Vector2i& c : summary.cells) cells.insert(Key(c.x(), c.y()));
+  return cells;
+}
+
+// The cells of `summary` with their centres mapped by T_ref_cur, snapped to a grid of `cell_m`.
+CellSet MappedCellsOf(const OccupancySummary& summary, const Pose2& T_ref_cur, double cell_m) {
+  const double l = summary.cell_size_m;
+  CellSet cells;
+  cells.reserve(summary.cells.size() * 2);
+  for (const Eigen::Vector2i& c : summary.cells) {
+    const Eigen::Vector2d p = T_ref_cur * Eigen::Vector2d((c.x() + 0.5) * l, (c.y() + 0.5) * l);
+    cells.insert(Key(static_cast<std::int64_t>(std::floor(p.x() / cell_m)),
+                     static_cast<std::int64_t>(std::floor(p.y() / cell_m))));
+  }
+  return cells;
+}
+
 }  // namespace
+
+double CommonAreaOverlap(const OccupancySummary& reference, const OccupancySummary& current,
+                         const OccupancySummary& reference_observed,
+                         const OccupancySummary& current_observed, const Pose2& T_ref_cur) {
+  const double l = reference.cell_size_m;
+  if (!(l > 0.0) || current.cell_size_m != l || reference_observed.cell_size_m != l ||
+      current_observed.cell_size_m != l) {
+    throw std::invalid_argument(
+        "CommonAreaOverlap: the four occupancy summaries need the same positive cell_size_m");
+  }
+  const CellSet reference_hit = CellsOf(reference);
+  const CellSet reference_seen = CellsOf(reference_observed);
+  const CellSet current_hit = MappedCellsOf(current, T_ref_cur, l);
+  const CellSet current_seen = MappedCellsOf(current_observed, T_ref_cur, l);
+  std::size_t intersection = 0;
+  std::size_t union_size = 0;
+  for (std::uint64_t key : reference_hit) {
+    if (current_seen.count(key) == 0) continue;
+    ++union_size;
+    intersection += current_hit.count(key);
+  }
+  for (std::uint64_t key : current_hit) {
+    if (reference_seen.count(key) != 0 && reference_hit.count(key) == 0) ++union_size;
+  }
+  return union_size == 0 ? 0.0 : static_cast<double>(intersection) / union_size;
+}
 
 double OccupancyOverlap(const OccupancySummary& reference, const OccupancySummary& current,
                         const Pose2& T_ref_cur, double cell_m) {

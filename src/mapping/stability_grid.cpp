@@ -246,4 +246,16 @@ std::vector<CellIndex> StabilityGrid::HitCells() const {
   return cells;
 }
 
+std::vector<CellIndex> StabilityGrid::ObservedCells() const {
+  std::vector<CellIndex> cells;
+  cells.reserve(static_cast<std::size_t>(observed_cells_));
+  for (int j = 0; j < height_; ++j) {
+    for (int i = 0; i < width_; ++i) {
+      const CellCounts& counts = counts_[static_cast<std::size_t>(j) * width_ + i];
+      if (counts.hits > 0 || counts.misses > 0) cells.push_back({i + origin_i_, j + origin_j_});
+    }
+  }
+  return cells;
+}
+
 }  // namespace keyplace

@@ -86,6 +86,14 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
 void OnlineSlam::CompleteSubmap(SlamStep& step) {
   auto start = std::chrono::steady_clock::now();
   Submap submap = mapper_.Snapshot();
+  {
+    OccupancySummary observed;
+    observed.cell_size_m = mapper_.grid().cell_size_m();
+    const std::vector<CellIndex> cells = mapper_.grid().ObservedCells();
+    observed.cells.reserve(cells.size());
+    for (const CellIndex& cell : cells) observed.cells.emplace_back(cell.i, cell.j);
+    observed_areas_.push_back(std::move(observed));
+  }
   mapper_.Reset();
   const int id = static_cast<int>(map_.submaps.size());
   submap.id = id;

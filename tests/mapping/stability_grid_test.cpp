@@ -54,6 +54,21 @@ TEST(StabilityGrid, StraightRayCountsMissesThenHit) {
   EXPECT_EQ(grid.observed_cell_count(), 4);
 }
 
+TEST(StabilityGrid, ObservedCellsAreTheCrossedAndHitCells) {
+  StabilityGrid grid(UnitCells());
+  grid.InsertRays({0.5, 0.5}, {{2.5, 1.5}, {0.5, -1.5}}, 0);
+  const std::vector<CellIndex> observed = grid.ObservedCells();
+  // Row by row: (0,-2) hit, (0,-1) crossed; (0,0) (1,0) crossed; (1,1) crossed, (2,1) hit.
+  const std::vector<CellIndex> expected{{0, -2}, {0, -1}, {0, 0}, {1, 0}, {1, 1}, {2, 1}};
+  ASSERT_EQ(observed.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(observed[k].i, expected[k].i) << k;
+    EXPECT_EQ(observed[k].j, expected[k].j) << k;
+  }
+  EXPECT_EQ(static_cast<std::int64_t>(observed.size()), grid.observed_cell_count());
+  EXPECT_EQ(grid.HitCells().size(), 2u);
+}
+
 TEST(StabilityGrid, DiagonalRayVisitsCellsInCrossingOrder) {
   StabilityGrid grid(UnitCells());
   // From (0.5, 0.5) to (2.5, 1.5): crosses x = 1 at t = 0.25, y = 1 at t = 0.5, x = 2 at 0.75.

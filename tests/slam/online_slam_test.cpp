@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/features/flirt.hpp"
 #include "registration/synthetic_scene.hpp"
 
@@ -173,6 +174,21 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
     ransac_error_sum += TranslationNorm(Between(truth_matched, loop.T_matched_cur_ransac));
   }
   EXPECT_LT(refined_error_sum, ransac_error_sum);
+  // Each loop's submaps largely agree where both looked under the loop transform, and do not
+  // 0.7 m and 6 deg off it (the simulated corridors keep a shift along one axis aligned, hence
+  // the diagonal).
+  for (const LoopClosure& loop : slam.loops()) {
+    const Submap& ref = slam.map().submaps[loop.reference_submap];
+    const Submap& cur = slam.map().submaps[loop.query_submap];
+    const OccupancySummary& ref_seen = slam.ObservedArea(loop.reference_submap);
+    const OccupancySummary& cur_seen = slam.ObservedArea(loop.query_submap);
+    EXPECT_GT(ref_seen.cells.size(), 5 * ref.occupancy.cells.size());
+    EXPECT_GT(CommonAreaOverlap(ref.occupancy, cur.occupancy, ref_seen, cur_seen, loop.T_ref_cur),
+              0.4);
+    EXPECT_LT(CommonAreaOverlap(ref.occupancy, cur.occupancy, ref_seen, cur_seen,
+                                Pose2(0.5, 0.5, 0.1) * loop.T_ref_cur),
+              0.2);
+  }
   // Every submap pose follows its node.
   for (const Submap& submap : slam.map().submaps) {
     const Pose2 node = slam.graph().node(submap.id);

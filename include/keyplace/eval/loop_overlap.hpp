@@ -21,6 +21,18 @@ namespace keyplace {
 double OccupancyOverlap(const OccupancySummary& reference, const OccupancySummary& current,
                         const Pose2& T_ref_cur, double cell_m = 0.0);
 
+/// The same intersection over union of the two submaps' occupied (hit) cells, counted only over
+/// the cells that *both* submaps observed (a beam of each ended in or crossed the cell;
+/// `reference_observed`, `current_observed`, e.g. OnlineSlam::ObservedArea): a cell occupied in
+/// one submap and outside the other's observed area is no disagreement, the other never looked
+/// there. Occupied cells of a submap are expected inside its observed area. All four summaries
+/// must have the same positive cell size (std::invalid_argument otherwise); `current`'s cell
+/// centres are mapped by T_ref_cur and snapped to the reference grid. In [0, 1]; 0 when no
+/// occupied cell lies in the common area.
+double CommonAreaOverlap(const OccupancySummary& reference, const OccupancySummary& current,
+                         const OccupancySummary& reference_observed,
+                         const OccupancySummary& current_observed, const Pose2& T_ref_cur);
+
 /// The paper's bins of overlap rate: [0,10), [10,20), [20,30), [30,40), [40,100] %.
 struct OverlapHistogram {
   static constexpr std::array<double, 6> kEdges{0.0, 0.1, 0.2, 0.3, 0.4, 1.0};

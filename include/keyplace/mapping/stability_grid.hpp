@@ -83,6 +83,8 @@ class StabilityGrid {
 
   /// Cells hit by at least one beam.
   std::vector<CellIndex> HitCells() const;
+  /// Cells hit or crossed by at least one beam (the observed area), row by row.
+  std::vector<CellIndex> ObservedCells() const;
   /// Cells whose first hit came from the latest InsertRays call.
   const std::vector<CellIndex>& newly_hit_cells() const { return newly_hit_cells_; }
 

@@ -163,6 +163,11 @@ class OnlineSlam {
   std::vector<ScanPose> Trajectory() const;
 
   const std::vector<LoopClosure>& loops() const { return loops_; }
+  /// The observed area of a completed submap: the cells of its stability grid G that some beam
+  /// ended in or crossed, in the submap frame (the binary grids of the paper's Eq. 7).
+  const OccupancySummary& ObservedArea(int submap) const {
+    return observed_areas_[static_cast<std::size_t>(submap)];
+  }
   /// True when an accepted loop's edge is enabled in the graph now (not switched off).
   bool LoopUsed(const LoopClosure& loop) const;
   const PoseGraph& graph() const { return graph_; }
@@ -185,8 +190,9 @@ class OnlineSlam {
   GlobalMap map_;
   std::vector<Pose2> icp_origins_;  // ICP T_world_robot of each submap's origin
   std::vector<std::vector<Pose2>> icp_submap_poses_;
-  std::vector<double> origin_path_m_;  // travelled path at each submap origin
-  std::vector<SubmapCloud> clouds_;    // one per completed submap (loop refinement)
+  std::vector<double> origin_path_m_;             // travelled path at each submap origin
+  std::vector<SubmapCloud> clouds_;               // one per completed submap (loop refinement)
+  std::vector<OccupancySummary> observed_areas_;  // one per completed submap
   // Endpoints (robot frame, range-filtered) of the scans of the submap in progress.
   std::vector<std::vector<Eigen::Vector2d>> pending_points_;
   std::vector<Place> places_;  // one per completed submap (place frame = submap frame)
