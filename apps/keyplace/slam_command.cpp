@@ -94,6 +94,31 @@ void RunSlam(SlamOptions options) {
     throw std::invalid_argument("--order '" + options.order + "': expected logger or file");
   }
 
+  // --- ground truth (optional): corrected pose of each raw scan that has one; read before the
+  // long run so that a bad file fails at once
+  std::vector<Pose2> corrected_poses;
+  std::vector<IndexPair> pairs;
+  std::vector<int> corrected_of(log.scans.size(), -1);
+  if (!options.truth_path.empty()) {
+    const CarmenLog corrected = ReadLogWithScans(options.truth_path);
+    for (const LaserScan& scan : corrected.scans) {
+      if (!scan.corrected_pose) {
+        throw std::invalid_argument(options.truth_path + ":" + std::to_string(scan.line) +
+                                    ": scan has no corrected pose");
+      }
+      corrected_poses.push_back(*scan.corrected_pose);
+    }
+    pairs = ReadIndexPairs(options.index_path);
+    for (const IndexPair& pair : pairs) {
+      if (pair.raw_index < corrected_of.size() && pair.corrected_index < corrected_poses.size()) {
+        corrected_of[pair.raw_index] = static_cast<int>(pair.corrected_index);
+      }
+    }
+  }
+
+  std::vector<Relation> relations;
+  if (!options.relations_path.empty()) relations = ReadRelations(options.relations_path);
+
   const auto keypoint_start = Clock::now();
   const FlirtExtractor extractor;
   Progress keypoint_progress("keypoints", log.scans.size());
@@ -148,27 +173,6 @@ void RunSlam(SlamOptions options) {
                            pose.T_world_robot_icp.theta);
       }
     });
-  }
-
-  // --- ground truth (optional): corrected pose of each raw scan that has one
-  std::vector<Pose2> corrected_poses;
-  std::vector<IndexPair> pairs;
-  std::vector<int> corrected_of(log.scans.size(), -1);
-  if (!options.truth_path.empty()) {
-    const CarmenLog corrected = ReadLogWithScans(options.truth_path);
-    for (const LaserScan& scan : corrected.scans) {
-      if (!scan.corrected_pose) {
-        throw std::invalid_argument(options.truth_path + ":" + std::to_string(scan.line) +
-                                    ": scan has no corrected pose");
-      }
-      corrected_poses.push_back(*scan.corrected_pose);
-    }
-    pairs = ReadIndexPairs(options.index_path);
-    for (const IndexPair& pair : pairs) {
-      if (pair.raw_index < corrected_of.size() && pair.corrected_index < corrected_poses.size()) {
-        corrected_of[pair.raw_index] = static_cast<int>(pair.corrected_index);
-      }
-    }
   }
 
   // --- loops: overlap of each matched pair under the estimated transform
@@ -546,7 +550,6 @@ void RunSlam(SlamOptions options) {
     }
   }
   if (!options.relations_path.empty()) {
-    const std::vector<Relation> relations = ReadRelations(options.relations_path);
     const RelationErrorReport r = EvaluateRelations(slam_timed, relations);
     const RelationErrorReport r_icp = EvaluateRelations(icp_timed, relations);
     fmt::print(
