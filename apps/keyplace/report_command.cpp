@@ -310,13 +310,13 @@ std::string TableIX(const ReportContext& context) {
     mapping.ours.push_back(
         Row(context, "keyplace slam", path, [&](const auto& j) { return MappingValues(j, path); }));
     loops.ours.push_back(Row(context, "keyplace slam", path, [&](const auto& j) {
-      return std::vector<std::optional<double>>{
-          Number(j, "loops_detected", path),       Number(j, "loops_used", path),
-          Number(j, "precision_overlap_10", path),
-          Number(j, "precision_overlap_30", path),
-          Number(j, "precision_overlap_30_common_area", path),
-          Number(j, "precision_truth", path),
-          Number(j, "ate_rmse_m", path)};
+      return std::vector<std::optional<double>>{Number(j, "loops_detected", path),
+                                                Number(j, "loops_used", path),
+                                                Number(j, "precision_overlap_10", path),
+                                                Number(j, "precision_overlap_30", path),
+                                                Number(j, "precision_overlap_30_common_area", path),
+                                                Number(j, "precision_truth", path),
+                                                Number(j, "ate_rmse_m", path)};
     }));
     mapping_groups.push_back(std::move(mapping));
     loop_groups.push_back(std::move(loops));

@@ -628,9 +628,11 @@ void RegisterSlamCommand(CLI::App& app) {
   command->add_option("--relations", options->relations_path, "Kümmerle et al. relation file")
       ->check(CLI::ExistingFile);
   command->add_option("--json", options->json_path, "write the figures as JSON");
-  command->add_option("--loops", options->loops_path,
-                      "write one TSV row per detected loop (submaps, first scans, transform, "
-                      "consensus, gamma, overlap, accepted, used)");
+  command->add_option(
+      "--loops", options->loops_path,
+      "write one TSV row per detected loop (submaps, first scans, transform, "
+      "consensus, gamma, overlap over all cells and over the common area, accepted, used, "
+      "ground-truth check)");
   command->add_option("--figures", options->figures_dir,
                       "write trajectory, overlap histogram, RPE and ATE pictures (PNG) here");
   command->add_option("--order", options->order, "processing order: logger (default) or file");
