@@ -74,24 +74,8 @@ double OccupancyOverlap(const OccupancySummary& reference, const OccupancySummar
   }
   if (cell_m < 0.0) throw std::invalid_argument("OccupancyOverlap: cell_m must be >= 0");
   const double l = cell_m > 0.0 ? cell_m : l_ref;
-  std::unordered_set<std::uint64_t> a;
-  a.reserve(reference.cells.size() * 2);
-  for (const Eigen::Vector2i& c : reference.cells) {
-    if (cell_m > 0.0) {
-      a.insert(Key(static_cast<std::int64_t>(std::floor((c.x() + 0.5) * l_ref / l)),
-                   static_cast<std::int64_t>(std::floor((c.y() + 0.5) * l_ref / l))));
-    } else {
-      a.insert(Key(c.x(), c.y()));
-    }
-  }
-  std::unordered_set<std::uint64_t> b;
-  b.reserve(current.cells.size() * 2);
-  for (const Eigen::Vector2i& c : current.cells) {
-    const Eigen::Vector2d centre((c.x() + 0.5) * l_cur, (c.y() + 0.5) * l_cur);
-    const Eigen::Vector2d p = T_ref_cur * centre;
-    b.insert(Key(static_cast<std::int64_t>(std::floor(p.x() / l)),
-                 static_cast<std::int64_t>(std::floor(p.y() / l))));
-  }
+  const CellSet a = cell_m > 0.0 ? MappedCellsOf(reference, Pose2(), l) : CellsOf(reference);
+  const CellSet b = MappedCellsOf(current, T_ref_cur, l);
   std::size_t intersection = 0;
   for (std::uint64_t key : b) intersection += a.count(key);
   const std::size_t union_size = a.size() + b.size() - intersection;
