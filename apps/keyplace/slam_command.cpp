@@ -26,7 +26,6 @@
 #include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/eval/relation_error.hpp"
 #include "keyplace/eval/trajectory_error.hpp"
-#include "keyplace/eval/truth_propagation.hpp"
 #include "keyplace/io/atomic_file.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/io/file_fingerprint.hpp"
@@ -36,6 +35,7 @@
 #include "keyplace/store/map_file.hpp"
 #include "paper_tables.hpp"
 #include "slam_figures.hpp"
+#include "slam_loop_evaluation.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -66,8 +66,6 @@ struct SlamOptions {
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
-
-double Deg(double rad) { return rad * 180.0 / M_PI; }
 
 void RunSlam(SlamOptions options) {
   using Clock = std::chrono::steady_clock;
@@ -175,164 +173,31 @@ void RunSlam(SlamOptions options) {
     });
   }
 
-  // --- loops: overlap of each matched pair under the estimated transform
+  // --- loops: overlap rates and the ground-truth check of each detected loop
   const std::vector<LoopClosure>& loops = slam.loops();
-  // Ground-truth check of a loop: the relative pose of its two submap origins implied by the loop
-  // (T_ref_cur) against the corrected one; correct within 0.5 m and 10 deg (DESIGN.md). An
-  // origin's corrected pose is its first scan's, or that of the nearest scan (processing order,
-  // within kTruthMaxGapScans) that has one, moved by the ICP odometry between the two.
-  std::vector<int> loop_truth(loops.size(), -1);  // -1 unknown, 0 wrong, 1 correct
-  std::vector<double> loop_truth_error_m(loops.size(), -1.0);
-  std::vector<std::optional<PropagatedTruth>> truth_of_scan(log.scans.size());
-  if (!corrected_poses.empty()) {
-    std::vector<std::optional<Pose2>> corrected_in_order;
-    std::vector<Pose2> icp_in_order;
-    for (const OnlineSlam::ScanPose& pose : trajectory) {
-      const int c = corrected_of[pose.scan_index];
-      corrected_in_order.push_back(c >= 0 ? std::optional<Pose2>(corrected_poses[c])
-                                          : std::nullopt);
-      icp_in_order.push_back(pose.T_world_robot_icp);
-    }
-    const std::vector<std::optional<PropagatedTruth>> propagated =
-        PropagateTruth(corrected_in_order, icp_in_order, kTruthMaxGapScans);
-    for (std::size_t k = 0; k < trajectory.size(); ++k) {
-      truth_of_scan[trajectory[k].scan_index] = propagated[k];
-    }
-  }
-  std::vector<int> truth_gaps;  // scans between each checked origin and its corrected scan
-  auto truth_error = [&](int ref_id, int cur_id, const Pose2& T_ref_cur, Pose2* error) {
-    const std::optional<PropagatedTruth>& ref = truth_of_scan[map.submaps[ref_id].first_scan()];
-    const std::optional<PropagatedTruth>& cur = truth_of_scan[map.submaps[cur_id].first_scan()];
-    if (!ref || !cur) return false;
-    *error = Between(Between(ref->T_world_robot, cur->T_world_robot), T_ref_cur);
-    return true;
-  };
-  std::size_t truth_evaluated = 0, truth_correct = 0;
-  std::vector<double> loop_truth_error_deg(loops.size(), -1.0);
-  // The same check of place recognition's own estimate (matched submap, RANSAC), where both the
-  // final and that one can be checked: the accuracy gained by the refinement.
-  std::vector<double> loop_truth_ransac_m(loops.size(), -1.0);
-  std::vector<double> loop_truth_ransac_deg(loops.size(), -1.0);
-  std::vector<double> paired_final_m, paired_ransac_m, paired_final_deg, paired_ransac_deg;
-  for (std::size_t k = 0; k < loops.size() && !corrected_poses.empty(); ++k) {
-    Pose2 error;
-    if (truth_error(loops[k].reference_submap, loops[k].query_submap, loops[k].T_ref_cur, &error)) {
-      loop_truth_error_m[k] = TranslationNorm(error);
-      loop_truth_error_deg[k] = std::abs(Deg(error.theta));
-      loop_truth[k] = TranslationNorm(error) <= 0.5 && std::abs(error.theta) <= 10.0 * M_PI / 180.0;
-      truth_gaps.push_back(truth_of_scan[map.submaps[loops[k].reference_submap].first_scan()]->gap);
-      truth_gaps.push_back(truth_of_scan[map.submaps[loops[k].query_submap].first_scan()]->gap);
-      ++truth_evaluated;
-      truth_correct += loop_truth[k];
-    }
-    Pose2 ransac_error;
-    if (truth_error(loops[k].matched_submap, loops[k].query_submap, loops[k].T_matched_cur_ransac,
-                    &ransac_error)) {
-      loop_truth_ransac_m[k] = TranslationNorm(ransac_error);
-      loop_truth_ransac_deg[k] = std::abs(Deg(ransac_error.theta));
-      if (loop_truth[k] >= 0) {
-        paired_final_m.push_back(loop_truth_error_m[k]);
-        paired_final_deg.push_back(loop_truth_error_deg[k]);
-        paired_ransac_m.push_back(loop_truth_ransac_m[k]);
-        paired_ransac_deg.push_back(loop_truth_ransac_deg[k]);
-      }
-    }
-  }
-  auto mean = [](const std::vector<double>& v) {
-    return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-  };
-  std::vector<double> overlaps, overlaps_used, overlaps_coarse, overlaps_ransac, overlaps_common;
-  std::size_t used = 0;
-  for (const LoopClosure& loop : loops) {
-    // Diagnostic: the overlap before refinement and partner choice (matched submap, RANSAC).
-    overlaps_ransac.push_back(OccupancyOverlap(map.submaps[loop.matched_submap].occupancy,
-                                               map.submaps[loop.query_submap].occupancy,
-                                               loop.T_matched_cur_ransac));
-    const double overlap =
-        OccupancyOverlap(map.submaps[loop.reference_submap].occupancy,
-                         map.submaps[loop.query_submap].occupancy, loop.T_ref_cur);
-    overlaps.push_back(overlap);
-    overlaps_common.push_back(CommonAreaOverlap(
-        map.submaps[loop.reference_submap].occupancy, map.submaps[loop.query_submap].occupancy,
-        slam.ObservedArea(loop.reference_submap), slam.ObservedArea(loop.query_submap),
-        loop.T_ref_cur));
-    overlaps_coarse.push_back(OccupancyOverlap(map.submaps[loop.reference_submap].occupancy,
-                                               map.submaps[loop.query_submap].occupancy,
-                                               loop.T_ref_cur, 0.2));
-    if (slam.LoopUsed(loop)) {
-      ++used;
-      overlaps_used.push_back(overlap);
-    }
-  }
-  if (!options.loops_path.empty()) {
-    WriteFileAtomically(options.loops_path, [&](std::ostream& out) {
-      out << "query_submap\tquery_first_scan\treference_submap\treference_first_scan\tx_m\ty_m\t"
-             "theta_rad\tpairs\tconsensus\tgamma\tconfidence\toverlap\toverlap_0_2m\t"
-             "path_between_m\tgate_m\tgate_deg\taccepted\tused\ttruth_correct\ttruth_error_m\t"
-             "matched_submap\tref_x_m\tref_y_m\tref_theta_rad\toverlap_matched_ransac\trefined\t"
-             "refine_correction_m\trefine_correction_deg\tinlier_ratio_initial\tinlier_ratio\t"
-             "point_overlap\trefine_status\ttruth_error_deg\ttruth_error_ransac_m\t"
-             "truth_error_ransac_deg\toverlap_common\n";
-      for (std::size_t k = 0; k < loops.size(); ++k) {
-        const LoopClosure& l = loops[k];
-        out << fmt::format(
-            "{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t"
-            "{:.2f}\t{:.3f}\t{:.2f}\t{}\t{}\t{}\t{:.3f}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{:.4f}\t{}\t"
-            "{:.4f}\t{:.3f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.3f}\t{:.3f}\t{:.3f}\t{:.4f}\n",
-            l.query_submap, map.submaps[l.query_submap].first_scan(), l.reference_submap,
-            map.submaps[l.reference_submap].first_scan(), l.T_ref_cur.x, l.T_ref_cur.y,
-            l.T_ref_cur.theta, l.pairs, l.consensus, l.gamma, l.confidence, overlaps[k],
-            overlaps_coarse[k], l.path_between_m, l.gate_translation_m, Deg(l.gate_rotation_rad),
-            l.accepted ? 1 : 0, slam.LoopUsed(l) ? 1 : 0, loop_truth[k], loop_truth_error_m[k],
-            l.matched_submap, l.T_matched_cur_ransac.x, l.T_matched_cur_ransac.y,
-            l.T_matched_cur_ransac.theta, overlaps_ransac[k], l.refined ? 1 : 0,
-            l.refine_correction_m, Deg(l.refine_correction_rad), l.refine_inlier_ratio_initial,
-            l.refine_inlier_ratio, l.point_overlap, ToString(l.refine_status),
-            loop_truth_error_deg[k], loop_truth_ransac_m[k], loop_truth_ransac_deg[k],
-            overlaps_common[k]);
-      }
-    });
-  }
-  const OverlapHistogram histogram = HistogramOfOverlaps(overlaps);
-  const double precision_10 = LoopPrecision(overlaps, 0.1);
-  const double precision_30 = LoopPrecision(overlaps, 0.3);
-  const double precision_used_30 = LoopPrecision(overlaps_used, 0.3);
-  const double precision_coarse_30 = LoopPrecision(overlaps_coarse, 0.3);
-  const OverlapHistogram histogram_common = HistogramOfOverlaps(overlaps_common);
-  // Both overlap rates as tests of loop correctness, scored on the loops ground truth can check:
-  // how many correct and how many wrong loops each passes at each threshold.
-  struct OverlapTest {
-    double threshold = 0.0;
-    std::size_t all_cells_correct = 0, all_cells_wrong = 0, common_correct = 0, common_wrong = 0;
-  };
-  std::vector<OverlapTest> overlap_tests;
-  std::size_t truth_wrong = 0;
-  for (double threshold : {0.1, 0.2, 0.3, 0.4, 0.5}) {
-    OverlapTest test;
-    test.threshold = threshold;
-    for (std::size_t k = 0; k < loops.size(); ++k) {
-      if (loop_truth[k] < 0) continue;
-      const bool correct = loop_truth[k] == 1;
-      if (overlaps[k] >= threshold) ++(correct ? test.all_cells_correct : test.all_cells_wrong);
-      if (overlaps_common[k] >= threshold) ++(correct ? test.common_correct : test.common_wrong);
-    }
-    overlap_tests.push_back(test);
-  }
-  for (int truth : loop_truth) truth_wrong += truth == 0;
+  const LoopEvaluation ev = EvaluateLoops(
+      slam, map, TruthOfEveryScan(trajectory, corrected_of, corrected_poses, kTruthMaxGapScans));
+  if (!options.loops_path.empty()) WriteLoopsTsv(options.loops_path, slam, map, ev);
+  const OverlapHistogram histogram = HistogramOfOverlaps(ev.overlap);
+  const OverlapHistogram histogram_common = HistogramOfOverlaps(ev.overlap_common);
+  const double precision_10 = LoopPrecision(ev.overlap, 0.1);
+  const double precision_30 = LoopPrecision(ev.overlap, 0.3);
+  const double precision_used_30 = LoopPrecision(ev.overlap_used, 0.3);
+  const double precision_coarse_30 = LoopPrecision(ev.overlap_coarse, 0.3);
   // The paper rejects matches of pairs with no overlap (minimal overlap 0.01): count them too.
   const std::size_t no_overlap = static_cast<std::size_t>(
-      std::count_if(overlaps.begin(), overlaps.end(), [](double o) { return o < 0.01; }));
+      std::count_if(ev.overlap.begin(), ev.overlap.end(), [](double o) { return o < 0.01; }));
 
   const auto dataset = DatasetName(options.input);
   fmt::print("log                {} ({} scans, {} order)\n", options.input, log.scans.size(),
              options.order);
   fmt::print("submaps            {} ({} queried)\n", s.submaps, s.queries);
   fmt::print("loops              {} detected, {} accepted by the gate, {} used in the graph\n",
-             loops.size(), s.loops_accepted, used);
+             loops.size(), s.loops_accepted, ev.used);
   fmt::print(
       "loop refinement    {} refined by ICP, {} with a neighbour of the matched submap as "
       "partner; precision at 30 % before refinement and partner choice {:.3f}\n",
-      s.loops_refined, s.loops_partner_changed, LoopPrecision(overlaps_ransac, 0.3));
+      s.loops_refined, s.loops_partner_changed, LoopPrecision(ev.overlap_matched_ransac, 0.3));
   if (config.loop_refinement.min_point_overlap > 0.0) {
     fmt::print("                   {} matches dropped by --loop-min-point-overlap {:.2f}\n",
                s.loops_rejected_by_point_overlap, config.loop_refinement.min_point_overlap);
@@ -346,26 +211,23 @@ void RunSlam(SlamOptions options) {
   fmt::print(
       "                   {:.3f} at 10 %, {:.3f} at 30 % counting only the area both submaps "
       "observed\n",
-      LoopPrecision(overlaps_common, 0.1), LoopPrecision(overlaps_common, 0.3));
+      LoopPrecision(ev.overlap_common, 0.1), LoopPrecision(ev.overlap_common, 0.3));
   if (!corrected_poses.empty()) {
     fmt::print(
         "                   {:.3f} against ground truth (0.5 m, 10 deg): {} of {} loops whose "
         "submap origins are at most {} scans from a corrected scan (mean {:.1f})\n",
-        truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0,
-        truth_correct, truth_evaluated, kTruthMaxGapScans,
-        truth_gaps.empty()
-            ? 0.0
-            : std::accumulate(truth_gaps.begin(), truth_gaps.end(), 0.0) / truth_gaps.size());
+        ev.precision_truth(), ev.truth_correct, ev.truth_evaluated, kTruthMaxGapScans,
+        ev.truth_mean_gap_scans);
     fmt::print(
         "                   loop transform error against ground truth, mean over {} loops: "
         "{:.3f} m / {:.2f} deg (place recognition's RANSAC estimate: {:.3f} m / {:.2f} deg)\n",
-        paired_final_m.size(), mean(paired_final_m), mean(paired_final_deg), mean(paired_ransac_m),
-        mean(paired_ransac_deg));
+        ev.paired_loops, ev.paired_final_m, ev.paired_final_deg, ev.paired_ransac_m,
+        ev.paired_ransac_deg);
   }
-  if (truth_evaluated > 0) {
+  if (ev.truth_evaluated > 0) {
     fmt::print("overlap as a correctness test, loops passing of the {} correct / {} wrong ones:\n",
-               truth_correct, truth_wrong);
-    for (const OverlapTest& t : overlap_tests) {
+               ev.truth_correct, ev.truth_wrong);
+    for (const OverlapTest& t : ev.overlap_tests) {
       if (t.threshold < 0.25 || t.threshold > 0.45) continue;
       fmt::print("                   at {:.0f} %: all cells {} / {}, common area {} / {}\n",
                  100.0 * t.threshold, t.all_cells_correct, t.all_cells_wrong, t.common_correct,
@@ -413,44 +275,43 @@ void RunSlam(SlamOptions options) {
   json["queries"] = s.queries;
   json["loops_detected"] = loops.size();
   json["loops_accepted"] = s.loops_accepted;
-  json["loops_used"] = used;
+  json["loops_used"] = ev.used;
   json["loops_refined"] = s.loops_refined;
   json["loops_partner_changed"] = s.loops_partner_changed;
   json["loops_rejected_by_point_overlap"] = s.loops_rejected_by_point_overlap;
-  json["precision_overlap_30_matched_ransac"] = LoopPrecision(overlaps_ransac, 0.3);
+  json["precision_overlap_30_matched_ransac"] = LoopPrecision(ev.overlap_matched_ransac, 0.3);
   json["optimizations"] = s.optimizations;
   json["ceres_solves"] = s.solves;
   json["precision_overlap_10"] = precision_10;
   json["precision_overlap_30"] = precision_30;
   json["precision_overlap_30_used"] = precision_used_30;
   json["precision_overlap_30_cells_0_2m"] = precision_coarse_30;
-  json["precision_overlap_10_cells_0_2m"] = LoopPrecision(overlaps_coarse, 0.1);
+  json["precision_overlap_10_cells_0_2m"] = LoopPrecision(ev.overlap_coarse, 0.1);
   json["loops_below_1_percent_overlap"] = no_overlap;
-  json["precision_overlap_10_common_area"] = LoopPrecision(overlaps_common, 0.1);
-  json["precision_overlap_30_common_area"] = LoopPrecision(overlaps_common, 0.3);
+  json["precision_overlap_10_common_area"] = LoopPrecision(ev.overlap_common, 0.1);
+  json["precision_overlap_30_common_area"] = LoopPrecision(ev.overlap_common, 0.3);
   json["overlap_histogram_common_area"] = histogram_common.counts;
   if (!corrected_poses.empty()) {
-    json["loops_truth_evaluated"] = truth_evaluated;
-    json["loops_truth_correct"] = truth_correct;
+    json["loops_truth_evaluated"] = ev.truth_evaluated;
+    json["loops_truth_correct"] = ev.truth_correct;
     json["loops_truth_max_gap_scans"] = kTruthMaxGapScans;
     nlohmann::json tests = nlohmann::json::array();
-    for (const OverlapTest& t : overlap_tests) {
+    for (const OverlapTest& t : ev.overlap_tests) {
       tests.push_back({{"threshold", t.threshold},
-                       {"correct", truth_correct},
-                       {"wrong", truth_wrong},
+                       {"correct", ev.truth_correct},
+                       {"wrong", ev.truth_wrong},
                        {"all_cells_correct_passed", t.all_cells_correct},
                        {"all_cells_wrong_passed", t.all_cells_wrong},
                        {"common_area_correct_passed", t.common_correct},
                        {"common_area_wrong_passed", t.common_wrong}});
     }
     json["overlap_vs_truth"] = tests;
-    json["loop_truth_error"] = {{"loops", paired_final_m.size()},
-                                {"translation_mean_m", mean(paired_final_m)},
-                                {"rotation_mean_deg", mean(paired_final_deg)},
-                                {"ransac_translation_mean_m", mean(paired_ransac_m)},
-                                {"ransac_rotation_mean_deg", mean(paired_ransac_deg)}};
-    json["precision_truth"] =
-        truth_evaluated > 0 ? static_cast<double>(truth_correct) / truth_evaluated : 0.0;
+    json["loop_truth_error"] = {{"loops", ev.paired_loops},
+                                {"translation_mean_m", ev.paired_final_m},
+                                {"rotation_mean_deg", ev.paired_final_deg},
+                                {"ransac_translation_mean_m", ev.paired_ransac_m},
+                                {"ransac_rotation_mean_deg", ev.paired_ransac_deg}};
+    json["precision_truth"] = ev.precision_truth();
   }
   json["overlap_histogram"] = histogram.counts;
   json["compression"] = stats.compression;
@@ -567,7 +428,7 @@ void RunSlam(SlamOptions options) {
     const std::string name = dataset ? *dataset : map.source_log;
     const std::filesystem::path dir(options.figures_dir);
     DrawTrajectoryFigure((dir / "trajectory.png").string(),
-                         fmt::format("{}: SLAM ({} loops used of {})", name, used, loops.size()),
+                         fmt::format("{}: SLAM ({} loops used of {})", name, ev.used, loops.size()),
                          figure_estimated, figure_truth, figure_loops);
     DrawHistogramFigure(
         (dir / "overlap_histogram.png").string(),
