@@ -6,6 +6,7 @@
 
 #include <fmt/core.h>
 
+#include "keyplace/eval/localization.hpp"
 #include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/io/atomic_file.hpp"
 
@@ -56,12 +57,12 @@ LoopEvaluation EvaluateLoops(const OnlineSlam& slam, const GlobalMap& map,
     const std::size_t scan = static_cast<std::size_t>(map.submaps[submap].first_scan());
     return scan < truth_of_scan.size() && truth_of_scan[scan] ? &truth_of_scan[scan] : nullptr;
   };
-  // Error of the relative pose T_ref_cur of two submap origins against the corrected one.
-  auto truth_error = [&](int ref_id, int cur_id, const Pose2& T_ref_cur) -> std::optional<Pose2> {
+  // The corrected relative pose of two submap origins, when both are known.
+  auto truth_between = [&](int ref_id, int cur_id) -> std::optional<Pose2> {
     const auto* ref = origin_truth(ref_id);
     const auto* cur = origin_truth(cur_id);
     if (ref == nullptr || cur == nullptr) return std::nullopt;
-    return Between(Between((*ref)->T_world_robot, (*cur)->T_world_robot), T_ref_cur);
+    return Between((*ref)->T_world_robot, (*cur)->T_world_robot);
   };
 
   std::vector<double> gaps, paired_final_m, paired_final_deg, paired_ransac_m, paired_ransac_deg;
@@ -82,21 +83,21 @@ LoopEvaluation EvaluateLoops(const OnlineSlam& slam, const GlobalMap& map,
       e.overlap_used.push_back(e.overlap.back());
     }
 
-    if (const auto error = truth_error(loop.reference_submap, loop.query_submap, loop.T_ref_cur)) {
-      e.truth_error_m[k] = TranslationNorm(*error);
-      e.truth_error_deg[k] = std::abs(Deg(error->theta));
-      // Correct within 0.5 m and 10 deg (DESIGN.md).
-      e.truth[k] = e.truth_error_m[k] <= 0.5 && std::abs(error->theta) <= 10.0 * M_PI / 180.0;
+    if (const auto truth = truth_between(loop.reference_submap, loop.query_submap)) {
+      const Pose2 error = Between(*truth, loop.T_ref_cur);
+      e.truth_error_m[k] = TranslationNorm(error);
+      e.truth_error_deg[k] = std::abs(Deg(error.theta));
+      e.truth[k] = IsCorrectPose(loop.T_ref_cur, *truth) ? 1 : 0;  // 0.5 m, 10 deg (DESIGN.md)
       gaps.push_back((*origin_truth(loop.reference_submap))->gap);
       gaps.push_back((*origin_truth(loop.query_submap))->gap);
       ++e.truth_evaluated;
       ++(e.truth[k] == 1 ? e.truth_correct : e.truth_wrong);
     }
     // The same check of place recognition's own estimate: the accuracy the refinement adds.
-    if (const auto error =
-            truth_error(loop.matched_submap, loop.query_submap, loop.T_matched_cur_ransac)) {
-      e.truth_error_ransac_m[k] = TranslationNorm(*error);
-      e.truth_error_ransac_deg[k] = std::abs(Deg(error->theta));
+    if (const auto truth = truth_between(loop.matched_submap, loop.query_submap)) {
+      const Pose2 error = Between(*truth, loop.T_matched_cur_ransac);
+      e.truth_error_ransac_m[k] = TranslationNorm(error);
+      e.truth_error_ransac_deg[k] = std::abs(Deg(error.theta));
       if (e.truth[k] >= 0) {
         paired_final_m.push_back(e.truth_error_m[k]);
         paired_final_deg.push_back(e.truth_error_deg[k]);
