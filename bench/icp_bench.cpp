@@ -134,7 +134,7 @@ const std::vector<Problem>* Problems(const std::string& name) {
   std::vector<std::vector<Eigen::Vector2d>> points;
   const std::size_t end = std::min(log->scans.size(), kFirst + kCount);
   for (std::size_t i = 0; i < end; ++i) {
-    const auto result = odometry.Add(log->scans[i]);
+    const auto result = odometry.Add(log->scans[i], log->scans[i].odometry_pose);
     T_world_laser.push_back(result.T_world_laser);
     points.push_back(keyplace::ScanOdometry::FilteredEndpoints(log->scans[i], config));
   }

@@ -4,21 +4,17 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <stdexcept>
 
 #include <fmt/core.h>
 
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace keyplace::cli {
 
-CarmenLog ReadLogWithScans(const std::string& path) {
-  CarmenLog log = ReadCarmenLog(path);
-  if (log.scans.empty()) {
-    throw std::invalid_argument(path + ": no laser scans (FLASER or ROBOTLASER1 lines) in " +
-                                std::to_string(log.lines) + " lines: is this a CARMEN log?");
-  }
-  return log;
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void WriteJson(const std::string& path, const nlohmann::json& json) {
@@ -82,6 +78,19 @@ void Progress::Finish() {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   fmt::print(stderr, "\r{}  {}/{}  done in {:.1f} s          \n", label_, total_, total_,
              elapsed_s);
+}
+
+StageProgress StageProgressBar() {
+  auto current = std::make_shared<std::unique_ptr<Progress>>();
+  auto stage_name = std::make_shared<std::string>();
+  return [current, stage_name](const std::string& stage, std::size_t done, std::size_t total) {
+    if (*current == nullptr || *stage_name != stage) {
+      *current = std::make_unique<Progress>(stage, total);
+      *stage_name = stage;
+    }
+    (*current)->Update(done);
+    if (done == total) (*current)->Finish();
+  };
 }
 
 }  // namespace keyplace::cli

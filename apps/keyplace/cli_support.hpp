@@ -8,12 +8,15 @@
 #include <nlohmann/json.hpp>
 
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
 
 namespace keyplace::cli {
 
-/// Reads a CARMEN log and throws std::invalid_argument when it holds no laser scans (so that a
-/// wrong file is reported instead of giving empty results).
-CarmenLog ReadLogWithScans(const std::string& path);
+/// ReadCarmenLogWithScans: a file without laser scans is an error naming it.
+inline CarmenLog ReadLogWithScans(const std::string& path) { return ReadCarmenLogWithScans(path); }
+
+/// Seconds since `start` (steady clock).
+double SecondsSince(std::chrono::steady_clock::time_point start);
 
 /// Writes `json` (pretty-printed) to `path` atomically.
 void WriteJson(const std::string& path, const nlohmann::json& json);
@@ -40,5 +43,8 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_print_;
 };
+
+/// Progress lines for the stages of PrepareLogInputs (one Progress per stage).
+StageProgress StageProgressBar();
 
 }  // namespace keyplace::cli

@@ -14,5 +14,6 @@ void RegisterLocalizeCommand(CLI::App& app);
 void RegisterSlamCommand(CLI::App& app);
 void RegisterSweepCommand(CLI::App& app);
 void RegisterReportCommand(CLI::App& app);
+void RegisterDumpConfigCommand(CLI::App& app);
 
 }  // namespace keyplace::cli

@@ -1,19 +1,48 @@
 #include "config_options.hpp"
 
-#include <stdexcept>
-
 namespace keyplace::cli {
 
-std::map<std::string, std::string> ParseAssignments(const std::vector<std::string>& items) {
-  std::map<std::string, std::string> values;
-  for (const auto& item : items) {
-    const auto equals = item.find('=');
-    if (equals == std::string::npos || equals == 0 || equals + 1 == item.size()) {
-      throw std::invalid_argument("--set '" + item + "': expected KEY=VALUE");
-    }
-    values[item.substr(0, equals)] = item.substr(equals + 1);
+void AddConfigOptions(CLI::App* command, ConfigOptions& options) {
+  command
+      ->add_option("--preset", options.preset,
+                   "Configuration preset: default, paper (the paper's place recognition) or strict "
+                   "(default plus the reference-coverage check, for maps recorded on another day)")
+      ->check(CLI::IsMember(ConfigPresetNames()))
+      ->capture_default_str();
+  command
+      ->add_option("--config", options.file,
+                   "YAML configuration file (any subset of `keyplace dump-config`)")
+      ->check(CLI::ExistingFile);
+  command->add_option("--set", options.assignments,
+                      "Override one setting, section.key=value (repeatable; keys: keyplace "
+                      "dump-config)");
+}
+
+Config ResolveConfig(const ConfigOptions& options, const std::function<void(Config&)>& after_preset,
+                     const std::vector<std::string>& aliases) {
+  Config config = PresetConfig(options.preset);
+  if (after_preset) after_preset(config);
+  if (!options.file.empty()) ApplyConfigFile(options.file, config);
+  for (const std::string& alias : aliases) ApplyConfigAssignment(alias, config);
+  for (const std::string& assignment : options.assignments) {
+    ApplyConfigAssignment(assignment, config);
   }
-  return values;
+  Validate(config);
+  return config;
+}
+
+nlohmann::json ConfigJson(const Config& config) {
+  nlohmann::json json = nlohmann::json::object();
+  for (const auto& [key, value] : ConfigKeyValues(config)) {
+    nlohmann::json* node = &json;
+    std::size_t start = 0;
+    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', start)) {
+      node = &(*node)[key.substr(start, dot - start)];
+      start = dot + 1;
+    }
+    (*node)[key.substr(start)] = value;
+  }
+  return json;
 }
 
 }  // namespace keyplace::cli

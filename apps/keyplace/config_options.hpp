@@ -1,13 +1,34 @@
 #pragma once
-// Command-line overrides of config structs: repeated --set KEY=VALUE.
+// The configuration options every command takes: --preset NAME, --config FILE.yaml and repeated
+// --set section.key=value (keyplace dump-config lists the keys).
 
-#include <map>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "keyplace/config/config.hpp"
+
 namespace keyplace::cli {
 
-/// Splits "key=value" items; throws std::invalid_argument naming a malformed item.
-std::map<std::string, std::string> ParseAssignments(const std::vector<std::string>& items);
+struct ConfigOptions {
+  std::string preset = "default";
+  std::string file;
+  std::vector<std::string> assignments;
+};
+
+/// Registers --preset, --config and --set on `command`.
+void AddConfigOptions(CLI::App* command, ConfigOptions& options);
+
+/// The effective configuration: the preset, then `after_preset` (a command's own defaults), then
+/// the file, then `aliases` (section.key=value from everyday flags such as --mu), then --set.
+Config ResolveConfig(const ConfigOptions& options,
+                     const std::function<void(Config&)>& after_preset = {},
+                     const std::vector<std::string>& aliases = {});
+
+/// The whole configuration as nested JSON objects (section -> key -> text value).
+nlohmann::json ConfigJson(const Config& config);
 
 }  // namespace keyplace::cli

@@ -14,7 +14,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "keyplace/features/flirt.hpp"
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 
@@ -37,7 +37,7 @@ void RunFeatures(const FeaturesOptions& options) {
   Progress progress("features", keypoints.size());
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = range.begin; i < range.end; ++i) {
-    const LaserScan& scan = log.scans[i];
+    const LogScan& scan = log.scans[i];
     keypoints[i - range.begin] = extractor.Extract(scan, LogLaserPose(scan));
     progress.Update(i - range.begin + 1);
   }

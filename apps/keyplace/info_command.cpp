@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "config_options.hpp"
 #include "commands.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_map.hpp"
@@ -144,6 +145,13 @@ nlohmann::json DescribeMap(const std::string& path, const GlobalMap& map) {
   nlohmann::json config;
   for (const auto& [key, value] : ToKeyValues(map.config)) config[key] = value;
   json["config"] = config;
+  // The whole configuration that made the map (maps of older versions did not record it).
+  if (!map.configuration.empty()) {
+    Config whole;
+    ApplyConfigYaml(map.configuration, path + " (recorded configuration)", whole);
+    json["configuration"] = ConfigJson(whole);
+    json["configuration_yaml"] = map.configuration;
+  }
   return json;
 }
 
@@ -165,7 +173,12 @@ void PrintMap(const nlohmann::json& json) {
   fmt::print("trajectory extent    {:.1f} m x {:.1f} m\n",
              json["trajectory_extent_m"][0].get<double>(),
              json["trajectory_extent_m"][1].get<double>());
-  fmt::print("parameters\n");
+  if (json.contains("configuration_yaml")) {
+    fmt::print("configuration that made the map (a --config file):\n{}",
+               json["configuration_yaml"].get<std::string>());
+    return;
+  }
+  fmt::print("mapping parameters (the map records no other configuration)\n");
   for (const auto& [key, value] : json["config"].items()) {
     fmt::print("  {:<27}{}\n", key, value.get<std::string>());
   }
@@ -189,9 +202,9 @@ void RegisterInfoCommand(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* command = app.add_subcommand(
       "info",
-      "Describe a CARMEN log: scans, beams, field of view, duration, path length, line "
-      "types, invalid beams.");
-  command->add_option("input", options->input, "CARMEN log (.log or .log.gz)")
+      "Describe a CARMEN log (scans, beams, field of view, duration, path length, line types, "
+      "invalid beams) or a map file (submaps, keypoints, the configuration that made it).");
+  command->add_option("input", options->input, "CARMEN log (.log or .log.gz) or map file (.kpm)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--json", options->json_path, "Also write the figures as JSON to FILE");

@@ -24,6 +24,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterSlamCommand(app);
   keyplace::cli::RegisterSweepCommand(app);
   keyplace::cli::RegisterReportCommand(app);
+  keyplace::cli::RegisterDumpConfigCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

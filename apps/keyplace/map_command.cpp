@@ -14,7 +14,7 @@
 #include "commands.hpp"
 #include "config_options.hpp"
 #include "keyplace/io/carmen_log.hpp"
-#include "keyplace/io/file_fingerprint.hpp"
+#include "io/file_fingerprint.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
@@ -31,50 +31,39 @@ struct MapOptions {
   std::string json_path;
   std::string png_path;
   std::string svg_path;
-  std::vector<std::string> assignments;
+  ConfigOptions config;
   bool overlap_only = false;
 };
 
-double Seconds(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 void RunMap(const MapOptions& options) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  MappingConfig config;
-  if (options.overlap_only) {
-    config.use_distribution = false;
-    config.min_stable_keypoints = 0;
-  }
-  ApplyKeyValues(ParseAssignments(options.assignments), config);
-
-  const CarmenLog log = ReadLogWithScans(options.input);
-  const PoseSource source = options.poses.empty()
-                                ? (log.corrected ? PoseSource::kCorrected : PoseSource::kIcp)
-                                : ParsePoseSource(options.poses);
-  const double read_seconds = Seconds(start);
-
-  const auto poses_start = Clock::now();
-  Progress pose_progress("poses (" + ToString(source) + ")", log.scans.size());
-  const std::vector<Pose2> poses = ScanPoses(
-      log, source, {}, [&](std::size_t done, std::size_t) { pose_progress.Update(done); });
-  pose_progress.Finish();
-  const double pose_seconds = Seconds(poses_start);
-
-  const auto keypoint_start = Clock::now();
-  const FlirtExtractor extractor;
-  const std::vector<std::vector<Keypoint>> keypoints = ExtractKeypoints(log, extractor);
-  const double keypoint_seconds = Seconds(keypoint_start);
+  const auto start = std::chrono::steady_clock::now();
+  const Config config = ResolveConfig(options.config, [&](Config& c) {
+    if (options.overlap_only) {
+      c.mapping.use_distribution = false;
+      c.mapping.min_stable_keypoints = 0;
+    }
+  });
+  LogInputOptions input_options;
+  if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
+  input_options.odometry = config.odometry;
+  input_options.features = config.features;
+  const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
+  const CarmenLog& log = inputs.log;
+  const PoseSource source = inputs.pose_source;
+  const double read_seconds = inputs.seconds_read;
+  const double pose_seconds = inputs.seconds_poses;
+  const double keypoint_seconds = inputs.seconds_keypoints;
 
   Progress map_progress("mapping", log.scans.size());
   GlobalMappingTimings timings;
-  GlobalMap map = BuildGlobalMap({log.scans, poses, keypoints}, config, &timings,
+  GlobalMap map = BuildGlobalMap({log.scans, inputs.poses, inputs.keypoints}, config.mapping,
+                                 &timings,
                                  [&](std::size_t next_scan) { map_progress.Update(next_scan); });
   map_progress.Finish();
-  map.source_log = std::filesystem::path(options.input).filename().string();
-  map.source_hash = FileFingerprint(options.input);
+  map.source_log = inputs.source_log;
+  map.source_hash = inputs.source_hash;
   map.pose_source = ToString(source);
+  map.configuration = ConfigToYaml(config);
   const MappingStats stats = ComputeStats(map);
   const double seconds_per_submap =
       timings.submap_seconds.empty()
@@ -128,8 +117,12 @@ void RunMap(const MapOptions& options) {
     MapFigureOptions figure;
     figure.title = fmt::format("{}: {} submaps, {} stable keypoints ({} poses)", map.source_log,
                                stats.submaps, stats.stable_keypoints, ToString(source));
-    if (!options.png_path.empty()) DrawMapFigure(options.png_path, map, log.scans, poses, figure);
-    if (!options.svg_path.empty()) DrawMapFigure(options.svg_path, map, log.scans, poses, figure);
+    if (!options.png_path.empty()) {
+      DrawMapFigure(options.png_path, map, log.scans, inputs.poses, figure);
+    }
+    if (!options.svg_path.empty()) {
+      DrawMapFigure(options.svg_path, map, log.scans, inputs.poses, figure);
+    }
   }
 
   if (!options.json_path.empty()) {
@@ -148,13 +141,11 @@ void RunMap(const MapOptions& options) {
     json["source_keypoints"] = stats.source_keypoints;
     json["seconds_per_submap"] = seconds_per_submap_all;
     json["seconds_per_submap_mapping_only"] = seconds_per_submap;
-    json["seconds_total"] = Seconds(start);
+    json["seconds_total"] = SecondsSince(start);
     json["seconds_poses"] = pose_seconds;
     json["seconds_keypoints"] = keypoint_seconds;
     json["seconds_mapping"] = timings.seconds_total;
-    nlohmann::json config_json;
-    for (const auto& [key, value] : ToKeyValues(config)) config_json[key] = value;
-    json["config"] = config_json;
+    json["config"] = ConfigJson(config);
     if (paper) {
       json["paper"] = {{"table", paper->table},
                        {"compression", paper->compression},
@@ -193,11 +184,7 @@ void RegisterMapCommand(CLI::App& app) {
   command->add_flag("--overlap-only", options->overlap_only,
                     "Complete submaps on the overlap criterion alone (paper Section 3.1.3, as "
                     "for Table II): no distribution or keypoint-count criterion");
-  command->add_option("--set", options->assignments,
-                      "Override a mapping parameter, KEY=VALUE (repeatable); keys: cell_size_m, "
-                      "min_stability, min_scan_count, descriptor_match_chi2, cluster_match, "
-                      "min_overlap, overlap_cells, use_distribution, max_distribution, "
-                      "distribution_cell_m, min_stable_keypoints, max_scans_per_submap");
+  AddConfigOptions(command, options->config);
   command->callback([options] { RunMap(*options); });
 }
 

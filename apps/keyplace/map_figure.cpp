@@ -65,7 +65,7 @@ void SubmapColour(cairo_t* cr, int id) {
 }  // namespace
 
 void DrawMapFigure(const std::string& path, const GlobalMap& map,
-                   const std::vector<LaserScan>& scans, const std::vector<Pose2>& poses,
+                   const std::vector<LogScan>& scans, const std::vector<Pose2>& poses,
                    const MapFigureOptions& options) {
   const bool svg = EndsWith(path, ".svg");
   if (!svg && !EndsWith(path, ".png")) {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
-#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_map.hpp"
 
 namespace keyplace::cli {
@@ -19,7 +19,7 @@ struct MapFigureOptions {
 /// Draws the map; the format follows the extension of `path` (.png or .svg). `poses` are the
 /// T_world_robot of `scans` (may be empty to draw keypoints only). Written atomically.
 void DrawMapFigure(const std::string& path, const GlobalMap& map,
-                   const std::vector<LaserScan>& scans, const std::vector<Pose2>& poses,
+                   const std::vector<LogScan>& scans, const std::vector<Pose2>& poses,
                    const MapFigureOptions& options);
 
 }  // namespace keyplace::cli

@@ -19,7 +19,7 @@
 #include "commands.hpp"
 #include "eval_json.hpp"
 #include "keyplace/eval/relation_error.hpp"
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/io/relations.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
@@ -133,8 +133,8 @@ void RunOdometry(OdometryOptions options) {
   Progress progress("odometry", range.end - range.begin);
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = range.begin; k < range.end; ++k) {
-    const LaserScan& scan = log.scans[order[k]];
-    const ScanOdometryResult result = odometry.Add(scan);
+    const LogScan& scan = log.scans[order[k]];
+    const ScanOdometryResult result = odometry.Add(scan, scan.odometry_pose);
     icp_trajectory.push_back({scan.timestamp_s, result.T_world_robot});
     if (scan.odometry_pose) {
       odometry_trajectory.push_back({scan.timestamp_s, *scan.odometry_pose});

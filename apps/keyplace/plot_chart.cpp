@@ -12,7 +12,7 @@
 
 #include <fmt/core.h>
 
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace keyplace::cli {
 namespace {

@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/place/place_config.hpp"
 #include "paper_parameters.hpp"

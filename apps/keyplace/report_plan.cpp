@@ -16,7 +16,7 @@
 
 #include <fmt/core.h>
 
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 extern char** environ;  // NOLINT(readability-redundant-declaration): POSIX, for posix_spawn
 

@@ -26,9 +26,9 @@
 #include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/eval/relation_error.hpp"
 #include "keyplace/eval/trajectory_error.hpp"
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "keyplace/io/carmen_log.hpp"
-#include "keyplace/io/file_fingerprint.hpp"
+#include "io/file_fingerprint.hpp"
 #include "keyplace/io/relations.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/slam/online_slam.hpp"
@@ -130,7 +130,7 @@ void RunSlam(SlamOptions options) {
   const auto slam_start = Clock::now();
   for (std::size_t k = 0; k < order.size(); ++k) {
     const std::size_t i = order[k];
-    slam.AddScan(static_cast<int>(i), log.scans[i], keypoints[i]);
+    slam.AddScan(static_cast<int>(i), log.scans[i], log.scans[i].odometry_pose, keypoints[i]);
     progress.Update(k + 1);
   }
   slam.Finish();

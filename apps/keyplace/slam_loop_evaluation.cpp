@@ -8,7 +8,7 @@
 
 #include "keyplace/eval/localization.hpp"
 #include "keyplace/eval/loop_overlap.hpp"
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace keyplace::cli {
 namespace {

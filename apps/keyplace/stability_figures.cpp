@@ -120,7 +120,7 @@ StabilityFigureSummary DrawStabilityFigures(const std::string& log_path, std::si
   }
   // Only the scans a submap can take: keypoints of the whole log are not needed.
   const std::size_t end = std::min(log.scans.size(), first_scan + kMaxScans);
-  log.scans = std::vector<LaserScan>(log.scans.begin() + static_cast<std::ptrdiff_t>(first_scan),
+  log.scans = std::vector<LogScan>(log.scans.begin() + static_cast<std::ptrdiff_t>(first_scan),
                                      log.scans.begin() + static_cast<std::ptrdiff_t>(end));
   const std::vector<Pose2> poses = ScanPoses(log, PoseSource::kCorrected);
   const FlirtExtractor extractor;
@@ -161,7 +161,7 @@ StabilityFigureSummary DrawStabilityFigures(const std::string& log_path, std::si
   const auto scan_view = [&](std::size_t local) {
     ScanView view;
     const Pose2 T = laser_in_submap(local);
-    const LaserScan& scan = log.scans[local];
+    const LogScan& scan = log.scans[local];
     for (std::size_t b = 0; b < scan.size(); ++b) {
       if (scan.valid[b] != 0 && scan.ranges_m[b] < 12.0)
         view.points.push_back(T * scan.Endpoint(b));

@@ -177,14 +177,14 @@ double ParamDegrees(const CarmenLog& log, const std::string& name, double fallba
 }
 
 // FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
-LaserScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& state, bool front) {
+LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& state, bool front) {
   fields.ExpectAtLeast(2, "name n ...");
   const std::size_t n = fields.Count(1, "n (beam count)", kMaxBeams);
   const std::string layout = "name n, " + std::to_string(n) +
                              " ranges, laser x y theta, robot x y theta, ipc_timestamp, host, "
                              "logger_timestamp";
   fields.ExpectFieldCount(n + 11, layout);
-  LaserScan scan;
+  LogScan scan;
   scan.line = line;
   scan.max_range_m = state.options.flaser_max_range_m;
   // FLASER carries no angular geometry: take the field of view from PARAM when the log gives it,
@@ -218,7 +218,7 @@ LaserScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& 
 
 // ROBOTLASER1 type start fov res max_range accuracy remission_mode n r1..rn m rem1..remm
 //   laser x y theta robot x y theta tv rv forward_safety side_safety turn_axis ipc host logger
-LaserScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState& state) {
+LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState& state) {
   fields.ExpectAtLeast(9,
                        "name type start_angle fov resolution max_range accuracy "
                        "remission_mode n ...");
@@ -234,7 +234,7 @@ LaserScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderSta
                                           "forward_safety side_safety turn_axis, ipc_timestamp, "
                                           "host, logger_timestamp");
   if (max_range_m <= 0.0) fields.Fail("field 'max_range' must be positive");
-  LaserScan scan;
+  LogScan scan;
   scan.line = line;
   scan.max_range_m = max_range_m;
   scan.ranges_m.resize(n);
@@ -352,6 +352,15 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
     }
   }
   return std::move(state.log);
+}
+
+CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options) {
+  CarmenLog log = ReadCarmenLog(path, options);
+  if (log.scans.empty()) {
+    throw std::invalid_argument(path + ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
+                                std::to_string(log.lines) + " lines: is this a CARMEN log?");
+  }
+  return log;
 }
 
 }  // namespace keyplace

@@ -1,4 +1,4 @@
-#include "keyplace/io/file_fingerprint.hpp"
+#include "io/file_fingerprint.hpp"
 
 #include <zlib.h>
 

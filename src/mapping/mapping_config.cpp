@@ -3,7 +3,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "keyplace/common/config_fields.hpp"
+#include "common/config_fields.hpp"
+#include "config/section_tables.hpp"
 
 namespace keyplace {
 namespace {
@@ -30,49 +31,58 @@ void Validate(const MappingConfig& config) {
 }  // namespace keyplace
 
 namespace keyplace {
-namespace {
 
-const ConfigFields<MappingConfig>& Fields() {
+const ConfigFields<MappingConfig>& MappingConfigFields() {
   using C = MappingConfig;
   static const ConfigFields<C> fields = [] {
     ConfigFields<C> table("MappingConfig");
-    table.Double("cell_size_m", &C::cell_size_m)
-        .Double("min_stability", &C::min_stability)
-        .Int("min_scan_count", &C::min_scan_count)
-        .Double("descriptor_match_chi2", &C::descriptor_match_chi2)
+    table.Double("cell_size_m", &C::cell_size_m, "m", "l_g: side of a cell of the stability grid G")
+        .Double("min_stability", &C::min_stability, "",
+                "s_min: a cell's keypoint is stable when s >= s_min")
+        .Int("min_scan_count", &C::min_scan_count, "", "ns_min: s = d * occ / max(ns, ns_min)")
+        .Double("descriptor_match_chi2", &C::descriptor_match_chi2, "",
+                "similar descriptors: symmetric chi2 below this")
         .Enum("density_counting", &C::density_counting,
-              {{C::DensityCounting::kScans, "scans"}, {C::DensityCounting::kBeams, "beams"}})
+              {{C::DensityCounting::kScans, "scans"}, {C::DensityCounting::kBeams, "beams"}},
+              "h and m of the density d = h / (h + m) counted per scan or per beam")
         .Enum("cluster_match", &C::cluster_match,
               {{C::ClusterMatch::kAnyMember, "any_member"},
-               {C::ClusterMatch::kLatestMember, "latest_member"}})
-        .Double("min_overlap", &C::min_overlap)
+               {C::ClusterMatch::kLatestMember, "latest_member"}},
+              "which member of a history cluster a new keypoint is compared with")
+        .Double("min_overlap", &C::min_overlap, "",
+                "rho_min: a submap is complete once rho = a_int / a_uni drops below")
         .Enum("overlap_cells", &C::overlap_cells,
-              {{C::OverlapCells::kHit, "hit"}, {C::OverlapCells::kObserved, "observed"}})
-        .Bool("use_distribution", &C::use_distribution)
-        .Double("max_distribution", &C::max_distribution)
-        .Double("distribution_cell_m", &C::distribution_cell_m)
+              {{C::OverlapCells::kHit, "hit"}, {C::OverlapCells::kObserved, "observed"}},
+              "cells of the binary occupancy grids of rho")
+        .Bool("use_distribution", &C::use_distribution,
+              "also require delta <= max_distribution to complete a submap")
+        .Double("max_distribution", &C::max_distribution, "", "delta_max")
+        .Double("distribution_cell_m", &C::distribution_cell_m, "m",
+                "l: cell of the grid of the histograms of delta")
         .Enum("distribution_laser_cells", &C::distribution_laser_cells,
               {{C::LaserCells::kHit, "hit"},
                {C::LaserCells::kOccupied, "occupied"},
-               {C::LaserCells::kPersistent, "persistent"}})
+               {C::LaserCells::kPersistent, "persistent"}},
+              "which cells of G are the laser points of delta")
         .Enum("distribution_normalization", &C::distribution_normalization,
               {{C::DistributionNormalization::kPoints, "points"},
-               {C::DistributionNormalization::kCells, "cells"}})
-        .Int("min_stable_keypoints", &C::min_stable_keypoints)
-        .Int("max_scans_per_submap", &C::max_scans_per_submap);
+               {C::DistributionNormalization::kCells, "cells"}},
+              "what the binary histograms of delta are divided by")
+        .Int("min_stable_keypoints", &C::min_stable_keypoints, "",
+             "a complete submap holds at least this many stable keypoints")
+        .Int("max_scans_per_submap", &C::max_scans_per_submap, "",
+             "close a submap after this many scans anyway (0 = never)");
     return table;
   }();
   return fields;
 }
 
-}  // namespace
-
 std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig& config) {
-  return Fields().ToKeyValues(config);
+  return MappingConfigFields().ToKeyValues(config);
 }
 
 void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config) {
-  Fields().Apply(values, config);
+  MappingConfigFields().Apply(values, config);
   Validate(config);
 }
 

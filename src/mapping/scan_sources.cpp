@@ -3,7 +3,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
 #include <stdexcept>
+
+#include "io/file_fingerprint.hpp"
 
 namespace keyplace {
 
@@ -26,7 +31,7 @@ std::string ToString(PoseSource source) {
   return "?";
 }
 
-Pose2 LogLaserPose(const LaserScan& scan) { return scan.logged_laser_pose; }
+Pose2 LogLaserPose(const LogScan& scan) { return scan.logged_laser_pose; }
 
 std::vector<Pose2> ScanPoses(const CarmenLog& log, PoseSource source,
                              const ScanOdometryConfig& icp_config,
@@ -36,13 +41,13 @@ std::vector<Pose2> ScanPoses(const CarmenLog& log, PoseSource source,
   if (source == PoseSource::kIcp) {
     ScanOdometry odometry(icp_config);
     for (std::size_t i = 0; i < log.scans.size(); ++i) {
-      poses.push_back(odometry.Add(log.scans[i]).T_world_robot);
+      poses.push_back(odometry.Add(log.scans[i], log.scans[i].odometry_pose).T_world_robot);
       if (progress) progress(i + 1, log.scans.size());
     }
     return poses;
   }
   for (std::size_t i = 0; i < log.scans.size(); ++i) {
-    const LaserScan& scan = log.scans[i];
+    const LogScan& scan = log.scans[i];
     const auto& pose = source == PoseSource::kCorrected ? scan.corrected_pose : scan.odometry_pose;
     if (!pose) {
       throw std::invalid_argument(log.path + ": scan " + std::to_string(i) + " (line " +
@@ -68,6 +73,55 @@ std::vector<std::vector<Keypoint>> ExtractKeypoints(const CarmenLog& log,
                     });
   if (progress) progress(log.scans.size(), log.scans.size());
   return keypoints;
+}
+
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options,
+                           const StageProgress& progress) {
+  auto start = std::chrono::steady_clock::now();
+  LogInputs inputs;
+  inputs.log = ReadCarmenLogWithScans(path);
+  std::vector<LogScan>& scans = inputs.log.scans;
+  inputs.file_scans = scans.size();
+  const std::size_t end = std::min(options.end_scan, scans.size());
+  const std::size_t begin = std::min(options.first_scan, end);
+  scans.erase(scans.begin() + static_cast<std::ptrdiff_t>(end), scans.end());
+  scans.erase(scans.begin(), scans.begin() + static_cast<std::ptrdiff_t>(begin));
+  if (scans.empty()) {
+    throw std::invalid_argument(path + ": no scan in the range " + std::to_string(begin) + ":" +
+                                std::to_string(end));
+  }
+  inputs.first_scan = begin;
+  inputs.source_log = std::filesystem::path(path).filename().string();
+  inputs.source_hash = FileFingerprint(path);
+  inputs.seconds_read = SecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  inputs.pose_source = options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected
+                                                                   : PoseSource::kIcp);
+  const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
+  inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
+                           [&](std::size_t done, std::size_t total) {
+                             if (progress) progress(pose_stage, done, total);
+                           });
+  inputs.seconds_poses = SecondsSince(start);
+
+  if (options.keypoints) {
+    start = std::chrono::steady_clock::now();
+    const FlirtExtractor extractor(options.features);
+    inputs.keypoints = ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
+      if (progress) progress("keypoints", done, total);
+    });
+    inputs.seconds_keypoints = SecondsSince(start);
+  }
+  return inputs;
 }
 
 }  // namespace keyplace

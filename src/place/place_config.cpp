@@ -3,7 +3,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "keyplace/common/config_fields.hpp"
+#include "common/config_fields.hpp"
+#include "config/section_tables.hpp"
 
 namespace keyplace {
 namespace {
@@ -12,60 +13,90 @@ void Require(bool ok, const std::string& field, const std::string& rule) {
   if (!ok) throw std::invalid_argument("PlaceRecognitionConfig." + field + " " + rule);
 }
 
-const ConfigFields<PlaceRecognitionConfig>& Fields() {
-  using C = PlaceRecognitionConfig;
+}  // namespace
+
+const ConfigFields<RansacConfig>& RansacConfigFields() {
+  using C = RansacConfig;
   static const ConfigFields<C> fields = [] {
-    ConfigFields<C> table("PlaceRecognitionConfig");
-    table.Int("min_pairs", &C::min_pairs)
-        .Int("max_candidates", &C::max_candidates)
-        .Double("descriptor_match_chi2", &C::descriptor_match_chi2)
-        .Enum("pair_matching", &C::pair_matching,
-              {{C::PairMatching::kQueryOrder, "query_order"},
-               {C::PairMatching::kGlobalGreedy, "global_greedy"}})
-        .Enum("query_keypoints", &C::query_keypoints,
-              {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}})
-        .Double("query_merge_m", &C::query_merge_m)
-        .Double("inlier_distance_m", &C::inlier_distance_m)
-        .Int("ransac_iterations", &C::ransac_iterations)
-        .Int("exhaustive_hypotheses_max_pairs", &C::exhaustive_hypotheses_max_pairs)
-        .Double("rigidity_m2", &C::rigidity_m2)
-        .Bool("refine", &C::refine)
-        .Int("seed", &C::seed)
-        .Int("verification_neighbours", &C::verification_neighbours)
-        .Int("min_consensus", &C::min_consensus)
-        .Enum("consensus_counting", &C::consensus_counting,
-              {{C::ConsensusCounting::kQueryKeypoints, "query_keypoints"},
-               {C::ConsensusCounting::kDistinctReference, "distinct_reference"}})
-        .Double("min_gamma", &C::min_gamma)
-        .Double("min_gamma_all_scans", &C::min_gamma_all_scans)
-        .Double("min_reference_coverage", &C::min_reference_coverage)
-        .Double("double_match_m", &C::double_match_m)
-        .Enum("gamma_counting", &C::gamma_counting,
-              {{C::GammaCounting::kUniquePairs, "unique_pairs"},
-               {C::GammaCounting::kPerKeypoint, "per_keypoint"}})
-        .Enum("selection", &C::selection,
-              {{C::Selection::kFirstVerified, "first_verified"},
-               {C::Selection::kBestScore, "best_score"}})
-        .Enum("score", &C::score,
-              {{C::Score::kGamma, "gamma"},
-               {C::Score::kConsensus, "consensus"},
-               {C::Score::kConsensusGamma, "consensus_gamma"}})
-        .Double("distinct_distance_m", &C::distinct_distance_m)
-        .Double("distinct_angle_deg", &C::distinct_angle_deg)
-        .Double("ambiguity_ratio", &C::ambiguity_ratio)
-        .Double("min_confidence", &C::min_confidence)
-        .Int("confidence_consensus", &C::confidence_consensus);
+    ConfigFields<C> table("RansacConfig");
+    table
+        .Double("inlier_distance_m", &C::inlier_distance_m, "m",
+                "a mapped query keypoint this close to its nearest reference keypoint is an inlier")
+        .Int("iterations", &C::iterations, "", "sampled 2-pair hypotheses (FLIRTLib: 18)")
+        .Int("exhaustive_max_pairs", &C::exhaustive_max_pairs, "",
+             "enumerate every pair of descriptor pairs up to this many pairs (0 = always sample)")
+        .Double("rigidity_m2", &C::rigidity_m2, "m^2", "FLIRTLib's rigidity pre-check of a sample")
+        .Bool("refine", &C::refine, "least-squares refit on the inliers, kept when it scores better")
+        .Int("seed", &C::seed, "", "random seed, combined with the place id");
     return table;
   }();
   return fields;
 }
 
-}  // namespace
+const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
+  using C = PlaceRecognitionConfig;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("PlaceRecognitionConfig");
+    table.Int("min_pairs", &C::min_pairs, "", "mu: unique descriptor pairs for a candidate submap")
+        .Int("max_candidates", &C::max_candidates, "",
+             "n_c: candidates verified, by increasing mean pair distance")
+        .Double("descriptor_match_chi2", &C::descriptor_match_chi2, "",
+                "a descriptor pair: symmetric chi2 below this")
+        .Enum("pair_matching", &C::pair_matching,
+              {{C::PairMatching::kQueryOrder, "query_order"},
+               {C::PairMatching::kGlobalGreedy, "global_greedy"}},
+              "how unique pairs are chosen: query order (Algorithm 3) or globally by distance")
+        .Enum("query_keypoints", &C::query_keypoints,
+              {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}},
+              "query keypoints paired and verified: the submap's stable ones or all its scans'")
+        .Double("query_merge_m", &C::query_merge_m, "m",
+                "all_scans: a query keypoint this close to a kept one is dropped")
+        .Nested("ransac", &C::ransac, RansacConfigFields())
+        .Int("verification_neighbours", &C::verification_neighbours, "",
+             "verify against the candidate and this many map neighbours on each side (0 = paper)")
+        .Int("min_consensus", &C::min_consensus, "", "first check: RANSAC inliers")
+        .Enum("consensus_counting", &C::consensus_counting,
+              {{C::ConsensusCounting::kQueryKeypoints, "query_keypoints"},
+               {C::ConsensusCounting::kDistinctReference, "distinct_reference"}},
+              "what the consensus counts")
+        .Double("min_gamma", &C::min_gamma, "",
+                "gamma_min: second check, Eq. (10), for stable query keypoints")
+        .Double("min_gamma_all_scans", &C::min_gamma_all_scans, "",
+                "gamma_min for queries verified with their all-scan keypoints")
+        .Double("min_reference_coverage", &C::min_reference_coverage, "",
+                "third check: share of reference keypoints in the overlap hit (0 = off)")
+        .Double("double_match_m", &C::double_match_m, "m",
+                "lambda: max distance of a doubly matched pair")
+        .Enum("gamma_counting", &C::gamma_counting,
+              {{C::GammaCounting::kUniquePairs, "unique_pairs"},
+               {C::GammaCounting::kPerKeypoint, "per_keypoint"}},
+              "how n_dm of gamma counts doubly matched keypoints")
+        .Enum("selection", &C::selection,
+              {{C::Selection::kFirstVerified, "first_verified"},
+               {C::Selection::kBestScore, "best_score"}},
+              "which verified candidate answers: the first (paper) or the best-scoring")
+        .Enum("score", &C::score,
+              {{C::Score::kGamma, "gamma"},
+               {C::Score::kConsensus, "consensus"},
+               {C::Score::kConsensusGamma, "consensus_gamma"}},
+              "score of a verified candidate")
+        .Double("distinct_distance_m", &C::distinct_distance_m, "m",
+                "two verified candidates are distinct beyond this distance ...")
+        .Double("distinct_angle_deg", &C::distinct_angle_deg, "deg", "... or this angle")
+        .Double("ambiguity_ratio", &C::ambiguity_ratio, "",
+                "ambiguous when a distinct candidate scores this fraction of the best (>= 1: never)")
+        .Double("min_confidence", &C::min_confidence, "", "answers below this confidence are refused")
+        .Int("confidence_consensus", &C::confidence_consensus, "",
+             "consensus at which the confidence's consensus factor saturates");
+    return table;
+  }();
+  return fields;
+}
 
 PlaceRecognitionConfig PaperPlaceConfig() {
   PlaceRecognitionConfig config;
   config.pair_matching = PlaceRecognitionConfig::PairMatching::kQueryOrder;
-  config.exhaustive_hypotheses_max_pairs = 0;
+  config.ransac.exhaustive_max_pairs = 0;
   config.selection = PlaceRecognitionConfig::Selection::kFirstVerified;
   config.score = PlaceRecognitionConfig::Score::kGamma;
   config.ambiguity_ratio = 1.0;
@@ -96,11 +127,10 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.max_candidates >= 1, "max_candidates", "must be >= 1");
   Require(config.descriptor_match_chi2 > 0.0, "descriptor_match_chi2", "must be positive");
   Require(config.query_merge_m >= 0.0, "query_merge_m", "must be >= 0");
-  Require(config.inlier_distance_m > 0.0, "inlier_distance_m", "must be positive");
-  Require(config.ransac_iterations >= 1, "ransac_iterations", "must be >= 1");
-  Require(config.exhaustive_hypotheses_max_pairs >= 0, "exhaustive_hypotheses_max_pairs",
-          "must be >= 0");
-  Require(config.rigidity_m2 > 0.0, "rigidity_m2", "must be positive");
+  Require(config.ransac.inlier_distance_m > 0.0, "ransac.inlier_distance_m", "must be positive");
+  Require(config.ransac.iterations >= 1, "ransac.iterations", "must be >= 1");
+  Require(config.ransac.exhaustive_max_pairs >= 0, "ransac.exhaustive_max_pairs", "must be >= 0");
+  Require(config.ransac.rigidity_m2 > 0.0, "ransac.rigidity_m2", "must be positive");
   Require(config.verification_neighbours >= 0, "verification_neighbours", "must be >= 0");
   Require(config.min_consensus >= 2, "min_consensus", "must be >= 2");
   Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");
@@ -118,12 +148,12 @@ void Validate(const PlaceRecognitionConfig& config) {
 }
 
 std::vector<std::pair<std::string, std::string>> ToKeyValues(const PlaceRecognitionConfig& config) {
-  return Fields().ToKeyValues(config);
+  return PlaceConfigFields().ToKeyValues(config);
 }
 
 void ApplyKeyValues(const std::map<std::string, std::string>& values,
                     PlaceRecognitionConfig& config) {
-  Fields().Apply(values, config);
+  PlaceConfigFields().Apply(values, config);
   Validate(config);
 }
 

@@ -344,12 +344,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
 
   // Geometric verification of the first n_c candidates.
   const auto verify_start = Clock::now();
-  RansacConfig ransac;
-  ransac.inlier_distance_m = config_.inlier_distance_m;
-  ransac.iterations = config_.ransac_iterations;
-  ransac.exhaustive_max_pairs = config_.exhaustive_hypotheses_max_pairs;
-  ransac.rigidity_m2 = config_.rigidity_m2;
-  ransac.refine = config_.refine;
+  RansacConfig ransac = config_.ransac;
   const std::size_t to_verify =
       std::min(candidates.size(), static_cast<std::size_t>(config_.max_candidates));
   std::vector<std::pair<int, int>> index_pairs;
@@ -363,7 +358,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     for (const DescriptorPair& pair : candidate.pairs) {
       index_pairs.emplace_back(pair.current, pair.reference);
     }
-    ransac.seed = PlaceSeed(config_.seed, place.id);
+    ransac.seed = PlaceSeed(config_.ransac.seed, place.id);
     // The reference: the candidate, then its map neighbours in its frame (pairs index the
     // candidate's keypoints, which come first).
     const std::vector<Eigen::Vector2d>* reference_positions = &place.positions;
@@ -371,7 +366,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     if (config_.verification_neighbours > 0) {
       extended_positions = place.positions;
       extended_descriptors = place.descriptors;
-      const double merge2 = config_.inlier_distance_m * config_.inlier_distance_m;
+      const double merge2 = config_.ransac.inlier_distance_m * config_.ransac.inlier_distance_m;
       const int index = candidate.place_index;
       const int count = static_cast<int>(places_.size());
       for (int offset = -config_.verification_neighbours; offset <= config_.verification_neighbours;
@@ -408,7 +403,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
                      config_.descriptor_match_chi2, config_.gamma_counting);
     if (gamma.gamma < min_gamma) continue;  // second check
     const double coverage = ReferenceCoverage(*reference_positions, *match_positions,
-                                              estimate.T_ref_cur, config_.inlier_distance_m);
+                                              estimate.T_ref_cur, config_.ransac.inlier_distance_m);
     if (coverage < min_coverage) continue;  // third check (ours)
     CandidateResult result;
     result.place_index = candidate.place_index;

@@ -1,4 +1,4 @@
-#include "keyplace/place/submap_query.hpp"
+#include "place/submap_query.hpp"
 
 namespace keyplace {
 

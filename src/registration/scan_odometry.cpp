@@ -109,7 +109,8 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
   last_keyframe_T_world_laser_ = T_world_laser;
 }
 
-ScanOdometryResult ScanOdometry::Add(const LaserScan& scan) {
+ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
+                                     const std::optional<Pose2>& T_odom_robot) {
   const auto start = std::chrono::steady_clock::now();
   ScanOdometryResult result;
   result.sequence = num_scans_;
@@ -119,8 +120,8 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan) {
 
   // Odometry increment of the laser since the previous scan.
   Pose2 odometry_increment;  // identity without odometry
-  if (scan.odometry_pose) {
-    const Pose2 odometry_laser = *scan.odometry_pose * T_robot_laser;
+  if (T_odom_robot) {
+    const Pose2 odometry_laser = *T_odom_robot * T_robot_laser;
     if (have_previous_odometry_)
       odometry_increment = Between(previous_odometry_laser_, odometry_laser);
     previous_odometry_laser_ = odometry_laser;
@@ -128,7 +129,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan) {
   }
 
   if (num_scans_ == 0) {
-    const Pose2 T_world_robot = scan.odometry_pose ? *scan.odometry_pose : Pose2();
+    const Pose2 T_world_robot = T_odom_robot ? *T_odom_robot : Pose2();
     result.T_world_robot = T_world_robot;
     result.T_world_laser = T_world_robot * T_robot_laser;
     result.T_world_robot_odometry_prediction = T_world_robot;

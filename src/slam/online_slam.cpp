@@ -51,10 +51,11 @@ OnlineSlam::OnlineSlam(const SlamConfig& config)
 OnlineSlam::~OnlineSlam() = default;
 
 SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
+                             const std::optional<Pose2>& T_odom_robot,
                              const std::vector<Keypoint>& keypoints) {
   SlamStep step;
   auto start = std::chrono::steady_clock::now();
-  step.odometry = odometry_.Add(scan);
+  step.odometry = odometry_.Add(scan, T_odom_robot);
   const Pose2& pose = step.odometry.T_world_robot;
   if (have_previous_) path_m_ += (pose.translation() - previous_icp_.translation()).norm();
   previous_icp_ = pose;

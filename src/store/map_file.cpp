@@ -208,6 +208,7 @@ void WriteAll(Database& db, const GlobalMap& map) {
         {"pose_source", map.pose_source},
         {"source_scans", std::to_string(map.source_scans)},
         {"source_keypoints", std::to_string(map.source_keypoints)},
+        {"configuration", map.configuration},
     };
     for (const auto& [key, value] : entries) meta.Bind(1, key).Bind(2, value).Run();
     Statement config(db, "INSERT INTO config (key, value) VALUES (?, ?)");
@@ -321,6 +322,7 @@ GlobalMap LoadMap(const std::string& path) {
   map.source_log = meta["source_log"];
   map.source_hash = meta["source_hash"];
   map.pose_source = meta["pose_source"];
+  map.configuration = meta["configuration"];
   try {
     map.source_scans = std::stoull(meta.at("source_scans"));
     map.source_keypoints = std::stoull(meta.at("source_keypoints"));

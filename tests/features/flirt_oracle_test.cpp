@@ -150,7 +150,7 @@ void CheckScans(const std::string& dataset, const std::vector<int>& scan_indices
   const FlirtExtractor untruncated(untruncated_config);
   for (const int index : scan_indices) {
     SCOPED_TRACE(dataset + " scan " + std::to_string(index));
-    const LaserScan& scan = log.scans.at(index);
+    const LogScan& scan = log.scans.at(index);
     const FlirtSignals signals = fast.ComputeSignals(scan, LaserPose(scan));
     ASSERT_EQ(signals.spanning_trees.size(), 3u);
     CheckSpanningTrees(signals);

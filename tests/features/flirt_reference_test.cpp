@@ -125,7 +125,7 @@ Figures CompareFirst50(const std::string& dataset) {
   Figures f;
   std::vector<double> chi2;
   for (int scan_index = 0; scan_index < 50; ++scan_index) {
-    const LaserScan& scan = log.scans.at(scan_index);
+    const LogScan& scan = log.scans.at(scan_index);
     const std::vector<Keypoint> ours = extractor.Extract(scan, LaserPose(scan));
     const auto it = reference.find(scan_index);
     const std::vector<ReferenceKeypoint> empty;
@@ -203,7 +203,7 @@ void CheckCounts(const std::string& dataset) {
   double theirs = 0.0, ours = 0.0;
   int equal_scans = 0;
   for (std::size_t i = 0; i < log.scans.size(); ++i) {
-    const LaserScan& scan = log.scans[i];
+    const LogScan& scan = log.scans[i];
     const int n = static_cast<int>(extractor.Detect(scan, LaserPose(scan)).size());
     theirs += counts.rows[i][c_n];
     ours += n;

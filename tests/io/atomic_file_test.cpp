@@ -1,4 +1,4 @@
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 #include <filesystem>
 #include <fstream>

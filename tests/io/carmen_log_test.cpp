@@ -64,7 +64,7 @@ TEST(CarmenLog, ReadsRawLogLineTypes) {
   EXPECT_DOUBLE_EQ(log.odometry[0].pose.theta, 0.5);
   EXPECT_DOUBLE_EQ(log.odometry[0].timestamp_s, 100.5);
 
-  const LaserScan& scan = log.scans[0];
+  const LogScan& scan = log.scans[0];
   EXPECT_EQ(scan.line, 4u);
   ASSERT_EQ(scan.size(), 4u);
   // FLASER: 180 degrees, start -pi/2, step pi/n (FLIRTLib's convention).
@@ -117,7 +117,7 @@ TEST(CarmenLog, CorrectedLogKeepsCorrectedPoseAndGraph) {
   const CarmenLog log = ReadCarmenLog(path);
   ASSERT_EQ(log.scans.size(), 1u);
   EXPECT_TRUE(log.corrected);
-  const LaserScan& scan = log.scans[0];
+  const LogScan& scan = log.scans[0];
   ASSERT_TRUE(scan.corrected_pose.has_value());
   EXPECT_FALSE(scan.odometry_pose.has_value());
   EXPECT_DOUBLE_EQ(scan.corrected_pose->x, 1.5);

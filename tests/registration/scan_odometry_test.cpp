@@ -21,7 +21,7 @@ using testing::ScanOptions;
 // bias, so that the dead-reckoned path drifts. Scans are cast from the true laser poses.
 struct Drive {
   std::vector<Pose2> truth_robot;
-  std::vector<LaserScan> scans;
+  std::vector<LogScan> scans;
 };
 
 Drive MakeDrive(const std::vector<testing::Segment>& world, int steps, const Pose2& step_motion,
@@ -38,7 +38,7 @@ Drive MakeDrive(const std::vector<testing::Segment>& world, int steps, const Pos
       odometry = odometry * Pose2(step_motion.x * 1.05, step_motion.y * 1.05,
                                   step_motion.theta + DegToRad(0.5));
     }
-    LaserScan scan = CastScan(world, truth * T_robot_laser, options, &rng);
+    LogScan scan{CastScan(world, truth * T_robot_laser, options, &rng)};
     scan.T_robot_laser = T_robot_laser;
     scan.odometry_pose = odometry;
     scan.timestamp_s = 100.0 + 0.1 * i;
@@ -63,7 +63,7 @@ TEST(ScanOdometryTest, CorrectsDriftingOdometryInARoom) {
   double worst_m = 0.0;
   double worst_deg = 0.0;
   for (std::size_t i = 0; i < drive.scans.size(); ++i) {
-    const ScanOdometryResult result = odometry.Add(drive.scans[i]);
+    const ScanOdometryResult result = odometry.Add(drive.scans[i], drive.scans[i].odometry_pose);
     EXPECT_EQ(result.sequence, i);
     EXPECT_DOUBLE_EQ(result.timestamp_s, drive.scans[i].timestamp_s);
     if (i == 0) {
@@ -96,7 +96,7 @@ TEST(ScanOdometryTest, CorridorDoesNotSlideAwayFromOdometry) {
       MakeDrive(world, 40, Pose2(0.1, 0.0, 0.0), Pose2(0.0, 0.0, 0.0), Pose2(), options, 9);
   ScanOdometry odometry;
   ScanOdometryResult last;
-  for (const LaserScan& scan : drive.scans) last = odometry.Add(scan);
+  for (const LogScan& scan : drive.scans) last = odometry.Add(scan, scan.odometry_pose);
   const Pose2& odom_end = *drive.scans.back().odometry_pose;
   const Pose2& truth_end = drive.truth_robot.back();
   // Along the axis the only information is odometry's: the estimate follows it (4.1 m, not the
@@ -115,27 +115,27 @@ TEST(ScanOdometryTest, EmptyScanFallsBackToOdometryAndIsFlagged) {
   const Drive drive =
       MakeDrive(world, 4, Pose2(0.1, 0.0, 0.0), Pose2(0.0, -1.0, 0.0), Pose2(), options, 1);
   ScanOdometry odometry;
-  odometry.Add(drive.scans[0]);
-  odometry.Add(drive.scans[1]);
-  LaserScan blind = drive.scans[2];
+  odometry.Add(drive.scans[0], drive.scans[0].odometry_pose);
+  odometry.Add(drive.scans[1], drive.scans[1].odometry_pose);
+  LogScan blind = drive.scans[2];
   std::fill(blind.valid.begin(), blind.valid.end(), std::uint8_t{0});
-  const ScanOdometryResult result = odometry.Add(blind);
+  const ScanOdometryResult result = odometry.Add(blind, blind.odometry_pose);
   EXPECT_EQ(result.status, ScanOdometryStatus::kFallbackTooFewPoints);
   EXPECT_TRUE(result.fell_back);
   EXPECT_FALSE(result.converged);
   EXPECT_NEAR(result.T_world_robot.x, result.T_world_robot_odometry_prediction.x, 1e-12);
   EXPECT_FALSE(result.keyframe);
   // The next normal scan registers again.
-  const ScanOdometryResult next = odometry.Add(drive.scans[3]);
+  const ScanOdometryResult next = odometry.Add(drive.scans[3], drive.scans[3].odometry_pose);
   EXPECT_EQ(next.status, ScanOdometryStatus::kRegistered);
 
   // A first scan without any point: no crash, the next scans fall back until a map exists.
   ScanOdometry fresh;
   LaserScan empty;
-  EXPECT_EQ(fresh.Add(empty).status, ScanOdometryStatus::kFirstScan);
-  EXPECT_EQ(fresh.Add(empty).status, ScanOdometryStatus::kFallbackTooFewPoints);
-  EXPECT_EQ(fresh.Add(drive.scans[0]).status, ScanOdometryStatus::kFallbackTooFewPoints);
-  EXPECT_EQ(fresh.Add(drive.scans[1]).status, ScanOdometryStatus::kRegistered);
+  EXPECT_EQ(fresh.Add(empty, std::nullopt).status, ScanOdometryStatus::kFirstScan);
+  EXPECT_EQ(fresh.Add(empty, std::nullopt).status, ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_EQ(fresh.Add(drive.scans[0], drive.scans[0].odometry_pose).status, ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_EQ(fresh.Add(drive.scans[1], drive.scans[1].odometry_pose).status, ScanOdometryStatus::kRegistered);
 }
 
 TEST(ScanOdometryTest, InvalidConfigThrowsNamingTheField) {

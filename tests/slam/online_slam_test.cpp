@@ -83,7 +83,7 @@ std::vector<Pose2> SquareLoopPath(double laps) {
 
 struct SimulatedRun {
   std::vector<Pose2> truth;
-  std::vector<LaserScan> scans;
+  std::vector<LogScan> scans;
 };
 
 SimulatedRun Simulate(double laps) {
@@ -105,7 +105,7 @@ SimulatedRun Simulate(double laps) {
       odometry = odometry * Pose2(1.03 * step.x + 0.002 * noise(rng), step.y + 0.002 * noise(rng),
                                   step.theta + d * 0.4 * M_PI / 180 + 0.001 * noise(rng));
     }
-    LaserScan scan = CastScan(world, run.truth[i], options, &rng);
+    LogScan scan{CastScan(world, run.truth[i], options, &rng)};
     scan.odometry_pose = odometry;
     scan.timestamp_s = scan.logger_timestamp_s = 0.1 * static_cast<double>(i);
     scan.logged_laser_pose = odometry;
@@ -138,7 +138,7 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   OnlineSlam slam(SimulationConfig());
   for (std::size_t i = 0; i < run.scans.size(); ++i) {
     const std::vector<Keypoint> keypoints = extractor.Extract(run.scans[i]);
-    slam.AddScan(static_cast<int>(i), run.scans[i], keypoints);
+    slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints);
   }
   slam.Finish();
   const std::vector<OnlineSlam::ScanPose> trajectory = slam.Trajectory();

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,9 +35,23 @@ struct GraphEdge {
   bool loop = false;  // listed after a "#LOOP EDGES" comment
 };
 
+/// A scan as a CARMEN log gives it: the sensor data plus what the log writes beside it.
+struct LogScan : LaserScan {
+  double logger_timestamp_s = 0.0;  // logger_timestamp (the monotonic one for Intel raw)
+  // Robot pose in the odometry frame (raw logs), when the log carries one.
+  std::optional<Pose2> odometry_pose;
+  // SLAM-corrected robot pose (corrected logs), when the log carries one.
+  std::optional<Pose2> corrected_pose;
+  // The laser pose exactly as the log writes it, in the log's frame (corrected or odometry).
+  // Recomposing robot pose * T_robot_laser differs from it by a few ulps, which is enough to
+  // flip near-equal edge lengths in FLIRT's spanning trees.
+  Pose2 logged_laser_pose;
+  std::size_t line = 0;  // 1-based line number of the laser line in its file
+};
+
 struct CarmenLog {
   std::string path;
-  std::vector<LaserScan> scans;  // FLASER / RLASER / ROBOTLASER1 in file order
+  std::vector<LogScan> scans;  // FLASER / RLASER / ROBOTLASER1 in file order
   std::vector<OdometryMessage> odometry;
   std::vector<GraphVertex> vertices;
   std::vector<GraphEdge> edges;
@@ -46,7 +61,7 @@ struct CarmenLog {
   std::size_t invalid_beams = 0;    // beams marked invalid because of NaN/inf/negative values
   std::size_t no_return_beams = 0;  // beams at or beyond max range (normal "no echo")
   // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
-  // stored in LaserScan::corrected_pose instead of odometry_pose.
+  // stored in LogScan::corrected_pose instead of odometry_pose.
   bool corrected = false;
 };
 
@@ -61,5 +76,9 @@ struct CarmenReadOptions {
 /// Reads a CARMEN log. Throws std::invalid_argument naming file, line and field on malformed
 /// input, std::runtime_error when the file cannot be opened or is truncated.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
+
+/// ReadCarmenLog, and throws std::invalid_argument naming the file when it holds no laser scan
+/// (a wrong file is reported instead of giving empty results).
+CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options = {});
 
 }  // namespace keyplace

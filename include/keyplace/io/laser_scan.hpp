@@ -1,9 +1,9 @@
 #pragma once
-// One 2D laser scan as read from a log, in the laser frame.
+// One 2D laser scan: the sensor data, in the laser frame. Where it came from (a log line, the
+// poses a log writes beside it) is LogScan's business (carmen_log.hpp).
 
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -19,21 +19,10 @@ struct LaserScan {
   std::vector<std::uint8_t> valid;
   double max_range_m = 0.0;  // readings at or beyond this are "no return"
 
-  double timestamp_s = 0.0;         // ipc_timestamp as written in the log
-  double logger_timestamp_s = 0.0;  // logger_timestamp (the monotonic one for Intel raw)
+  double timestamp_s = 0.0;  // acquisition time (s)
 
-  // Robot pose in the odometry frame (raw logs), when the log carries one.
-  std::optional<Pose2> odometry_pose;
-  // SLAM-corrected robot pose (corrected logs), when the log carries one.
-  std::optional<Pose2> corrected_pose;
   // Mounting of the laser on the robot: laser pose = robot pose * T_robot_laser.
   Pose2 T_robot_laser;
-  // The laser pose exactly as the log writes it, in the log's frame (corrected or odometry).
-  // Recomposing robot pose * T_robot_laser differs from it by a few ulps, which is enough to
-  // flip near-equal edge lengths in FLIRT's spanning trees.
-  Pose2 logged_laser_pose;
-
-  std::size_t line = 0;  // 1-based line number of the laser line in its file
 
   std::size_t size() const { return ranges_m.size(); }
   std::size_t CountValid() const;

@@ -19,6 +19,9 @@ struct GlobalMap {
   std::size_t source_scans = 0;  // scans in the log
   // FLIRT keypoints of all the scans of the log: the denominator of the compression ratio.
   std::size_t source_keypoints = 0;
+  // The whole configuration that made the map, as YAML (keyplace dump-config); empty when the
+  // maker did not record it (maps from older versions).
+  std::string configuration;
 
   std::size_t KeypointCount() const;
 };
@@ -33,6 +36,9 @@ struct MappingStats {
   std::size_t forced_submaps = 0;  // closed by max_scans_per_submap
   std::size_t stable_keypoints = 0;
   std::size_t source_keypoints = 0;
+  // The whole configuration that made the map, as YAML (keyplace dump-config); empty when the
+  // maker did not record it (maps from older versions).
+  std::string configuration;
 };
 
 MappingStats ComputeStats(const GlobalMap& map);

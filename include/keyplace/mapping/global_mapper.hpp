@@ -7,7 +7,7 @@
 
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/features/keypoint.hpp"
-#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/local_mapper.hpp"
 
@@ -15,7 +15,7 @@ namespace keyplace {
 
 /// Everything mapping reads about the scans of a log, by scan index (views, no copies).
 struct ScanSequence {
-  const std::vector<LaserScan>& scans;
+  const std::vector<LogScan>& scans;
   const std::vector<Pose2>& poses;                      // T_world_robot of every scan
   const std::vector<std::vector<Keypoint>>& keypoints;  // FLIRT keypoints (laser frame)
 

@@ -1,7 +1,9 @@
 #pragma once
 // What mapping needs per scan of a log: a robot pose from the chosen source and FLIRT keypoints.
 
+#include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,7 +38,42 @@ std::vector<std::vector<Keypoint>> ExtractKeypoints(const CarmenLog& log,
                                                     const FlirtExtractor& extractor,
                                                     const ProgressCallback& progress = {});
 
-/// The laser pose the log writes for a scan, exactly as written (LaserScan::logged_laser_pose).
-Pose2 LogLaserPose(const LaserScan& scan);
+/// The laser pose the log writes for a scan, exactly as written (LogScan::logged_laser_pose).
+Pose2 LogLaserPose(const LogScan& scan);
+
+/// What to prepare from a log.
+struct LogInputOptions {
+  std::optional<PoseSource> poses;  // default: corrected when the log has them, else icp
+  ScanOdometryConfig odometry;      // for PoseSource::kIcp
+  FlirtConfig features;
+  // Keep only the scans [first_scan, end_scan) of the file (clamped), before anything else.
+  std::size_t first_scan = 0;
+  std::size_t end_scan = static_cast<std::size_t>(-1);
+  bool keypoints = true;  // false: leave LogInputs::keypoints empty
+};
+
+/// Progress of a preparation stage ("poses (icp)", "keypoints"): (stage, done, total).
+using StageProgress = std::function<void(const std::string&, std::size_t, std::size_t)>;
+
+/// A log read and prepared for mapping and place recognition: its scans, a pose per scan and
+/// the FLIRT keypoints of every scan, with where they came from.
+struct LogInputs {
+  CarmenLog log;  // scans cut to the requested range
+  PoseSource pose_source = PoseSource::kCorrected;
+  std::vector<Pose2> poses;                      // T_world_robot of every scan
+  std::vector<std::vector<Keypoint>> keypoints;  // laser frame
+  std::string source_log;                        // file name of the log
+  std::string source_hash;                       // FileFingerprint of the log
+  std::size_t first_scan = 0;                    // index in the file of scans[0]
+  std::size_t file_scans = 0;                    // scans in the file (before the cut)
+  double seconds_read = 0.0;
+  double seconds_poses = 0.0;
+  double seconds_keypoints = 0.0;
+};
+
+/// Reads `path` (throws std::invalid_argument when it holds no laser scan), cuts it to the range,
+/// computes the poses and the keypoints. `progress` may be empty.
+LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options = {},
+                           const StageProgress& progress = {});
 
 }  // namespace keyplace

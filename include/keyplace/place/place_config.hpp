@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "keyplace/place/ransac.hpp"
+
 namespace keyplace {
 
 struct PlaceRecognitionConfig {
@@ -28,16 +30,10 @@ struct PlaceRecognitionConfig {
   QueryKeypoints query_keypoints = QueryKeypoints::kAllScans;
   double query_merge_m = 0.05;  // kAllScans: a keypoint within this of a kept one is dropped
 
-  // --- RANSAC (Section 4.1.1; FLIRTLib's RansacFeatureSetMatcher)
-  double inlier_distance_m = 0.1;  // acceptance: a transformed query keypoint within this of its
-                                   // geometric nearest reference keypoint is an inlier
-  int ransac_iterations = 18;      // random 2-pair hypotheses (FLIRTLib: p = 0.95, w = 0.4 -> 18)
-  // Enumerate every pair of descriptor pairs instead of sampling when there are at most this many
-  // descriptor pairs (n (n-1) / 2 hypotheses); 0 = always sample.
-  int exhaustive_hypotheses_max_pairs = 40;
-  double rigidity_m2 = 0.0064;  // FLIRTLib's rigidity pre-check of a hypothesis (squared metres)
-  bool refine = true;           // least-squares refit on the inliers (FLIRTLib does)
-  std::uint64_t seed = 1;       // RANSAC seed, combined with the place id
+  // --- RANSAC (Section 4.1.1; FLIRTLib's RansacFeatureSetMatcher): inlier threshold, 18 sampled
+  // hypotheses (FLIRTLib: p = 0.95, w = 0.4), every pair enumerated up to 40 descriptor pairs,
+  // rigidity pre-check, refit on the inliers; the seed is combined with the place id.
+  RansacConfig ransac;
 
   // --- geometric verification (Section 4.2)
   // Beyond the paper: verify (consensus and gamma) against the candidate submap together with

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -85,8 +86,8 @@ class ScanOdometry {
   ScanOdometry& operator=(const ScanOdometry&) = delete;
 
   /// Registers the next scan. The odometry increment since the previous scan initialises ICP;
-  /// a scan without odometry_pose is predicted with zero motion.
-  ScanOdometryResult Add(const LaserScan& scan);
+  /// a scan without odometry (T_odom_robot empty) is predicted with zero motion.
+  ScanOdometryResult Add(const LaserScan& scan, const std::optional<Pose2>& T_odom_robot);
 
   const ScanOdometryConfig& config() const { return config_; }
   std::size_t num_scans() const { return num_scans_; }

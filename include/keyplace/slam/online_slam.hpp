@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -142,9 +143,11 @@ class OnlineSlam {
   OnlineSlam(const OnlineSlam&) = delete;
   OnlineSlam& operator=(const OnlineSlam&) = delete;
 
-  /// Adds the next scan (processing order) with its FLIRT keypoints (laser frame). `scan_index`
-  /// is the caller's index of the scan (e.g. its file index), kept in the submaps and poses.
-  SlamStep AddScan(int scan_index, const LaserScan& scan, const std::vector<Keypoint>& keypoints);
+  /// Adds the next scan (processing order) with the robot's odometry pose when there is one and
+  /// its FLIRT keypoints (laser frame). `scan_index` is the caller's index of the scan (e.g. its
+  /// file index), kept in the submaps and poses.
+  SlamStep AddScan(int scan_index, const LaserScan& scan, const std::optional<Pose2>& T_odom_robot,
+                   const std::vector<Keypoint>& keypoints);
 
   /// Optimises the graph once more (if it has loops) and updates the map's poses.
   void Finish();

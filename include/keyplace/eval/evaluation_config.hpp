@@ -1,0 +1,19 @@
+#pragma once
+// Settings of the evaluations (not of the method): how relations are split and how far ground
+// truth is carried to scans without a corrected pose.
+
+namespace keyplace {
+
+struct EvaluationConfig {
+  // Relations with |t_b - t_a| below this are local, the others loop (Kümmerle et al.).
+  double local_relation_max_dt_s = 5.0;
+  // A loop of `keyplace slam` is checked against ground truth when its submap origins lie at most
+  // this many scans (processing order) from a scan with a corrected pose; FR101 has one corrected
+  // scan per 16 raw ones.
+  int truth_max_gap_scans = 50;
+};
+
+/// Throws std::invalid_argument naming the first invalid field.
+void Validate(const EvaluationConfig& config);
+
+}  // namespace keyplace

@@ -1,0 +1,117 @@
+#pragma once
+// Global localization of a robot in a map of stable-keypoint submaps, one scan at a time (paper
+// Algorithm 4 as a robot lives it): every scan and its odometry pose go into a query submap built
+// exactly as the map's submaps were (the map's own mapping configuration); when the query submap
+// is complete it is recognised against the map and the localizer answers where the robot is.
+// Memory is bounded: only the scans of the query submap being built are kept.
+//
+//   keyplace::GlobalLocalizer localizer(keyplace::LoadMap("site.kpm"));
+//   for (each scan, odometry pose) {
+//     if (auto fix = localizer.AddScan(scan, T_odom_robot); fix && fix->found) {
+//       use(fix->T_world_robot, fix->confidence);
+//     }
+//   }
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/flirt.hpp"
+#include "keyplace/features/keypoint.hpp"
+#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/localization/query_builder.hpp"
+#include "keyplace/place/place_config.hpp"
+#include "keyplace/place/place_recognizer.hpp"
+
+namespace keyplace {
+
+struct LocalizerConfig {
+  PlaceRecognitionConfig place;  // the top-level `place` section
+  // A query submap that is not complete after this many scans is recognised as it stands (when
+  // the map's own max_scans_per_submap is smaller, that one closes it first). Bounds memory.
+  int max_query_scans = 300;
+};
+
+/// Throws std::invalid_argument naming the first invalid field.
+void Validate(const LocalizerConfig& config);
+
+/// One answer of the localizer.
+struct LocalizationResult {
+  bool found = false;      // the match was accepted (verified, not ambiguous, confident enough)
+  bool ambiguous = false;  // another distinct place scored nearly as well
+  double confidence = 0.0;
+  int submap_id = -1;  // matched map submap (place id), -1 when nothing was verified
+  // Valid when a candidate was verified (match.verified): the robot's pose in the map at the
+  // latest scan, and the map <- odometry correction (T_world_robot = T_world_odom * T_odom_robot).
+  Pose2 T_world_robot;
+  Pose2 T_world_odom;
+  std::size_t scans = 0;      // scans in the query
+  std::vector<int> scan_ids;  // their ids as given to AddScan (-1 when none was given)
+  Pose2 T_odom_origin;        // odometry pose of the query's first scan (the query frame)
+  PlaceMatch match;           // all the details of the recognition
+};
+
+/// Which map places a query must not be matched with, given the ids of the query's scans (the
+/// `scan_id` passed to AddScan). For evaluations on the map's own log; empty = none.
+using QueryExclusion = std::function<bool(const Place&, const std::vector<int>& query_scan_ids)>;
+
+class GlobalLocalizer {
+ public:
+  /// Localizes in `map` with its own mapping configuration. Throws std::invalid_argument for an
+  /// invalid config.
+  explicit GlobalLocalizer(const GlobalMap& map, const LocalizerConfig& config = {},
+                           const FlirtConfig& features = {});
+  /// The same from a map file (LoadMap).
+  static GlobalLocalizer FromFile(const std::string& map_path, const LocalizerConfig& config = {},
+                                  const FlirtConfig& features = {});
+
+  /// Adds the next scan with the robot's pose in its odometry frame. Returns an answer when the
+  /// query submap completes with this scan (then the next scan starts a new query), else nullopt.
+  std::optional<LocalizationResult> AddScan(const LaserScan& scan, const Pose2& T_odom_robot);
+
+  /// The same with the scan's FLIRT keypoints already extracted (laser frame) and the caller's
+  /// id of the scan (for `exclusion`).
+  std::optional<LocalizationResult> AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
+                                            std::vector<Keypoint> keypoints, int scan_id = -1);
+
+  /// Recognises the query as it stands (incomplete), e.g. when the robot must decide now.
+  /// nullopt when no scan has been added since the last answer or Reset.
+  std::optional<LocalizationResult> LocalizeNow() const;
+
+  /// Forgets the query being built (the robot was kidnapped).
+  void Reset();
+
+  void set_exclusion(QueryExclusion exclusion) { exclusion_ = std::move(exclusion); }
+
+  std::size_t buffered_scans() const { return builder_.size(); }
+  const PlaceRecognizer& recognizer() const { return *recognizer_; }
+  const MappingConfig& mapping_config() const { return mapping_config_; }
+  const LocalizerConfig& config() const { return config_; }
+
+ private:
+  GlobalLocalizer(std::vector<Place> places, const MappingConfig& mapping,
+                  const LocalizerConfig& config, const FlirtConfig& features);
+  LocalizationResult Localize() const;
+
+  LocalizerConfig config_;
+  MappingConfig mapping_config_;
+  std::shared_ptr<const PlaceRecognizer> recognizer_;
+  std::shared_ptr<const FlirtExtractor> extractor_;
+  SubmapQueryBuilder builder_;
+  QueryExclusion exclusion_;
+};
+
+/// One scan against single-scan places (the TIP-FLIRT baseline: every scan of a log is a
+/// place): the query is the scan's keypoints, the answer its pose. `keypoints` in the laser
+/// frame; `T_odom_robot` only sets the returned T_world_odom.
+LocalizationResult LocalizeScan(const PlaceRecognizer& recognizer, const LaserScan& scan,
+                                const std::vector<Keypoint>& keypoints,
+                                const Pose2& T_odom_robot = {},
+                                const PlaceExclusion& exclusion = {});
+
+}  // namespace keyplace

@@ -1,0 +1,140 @@
+#include "keyplace/config/config.hpp"
+
+#include <stdexcept>
+
+#include "config/section_tables.hpp"
+
+namespace keyplace {
+namespace {
+
+// The whole configuration as one table. SlamConfig and LocalizerConfig embed copies of other
+// sections; their tables leave those out, and ToSlamConfig / ToLocalizerConfig put them in.
+const ConfigFields<Config>& ConfigTable() {
+  static const ConfigFields<Config> fields = [] {
+    ConfigFields<Config> table("config");
+    table.Nested("features", &Config::features, FlirtConfigFields())
+        .Nested("odometry", &Config::odometry, ScanOdometryConfigFields())
+        .Nested("mapping", &Config::mapping, MappingConfigFields())
+        .Nested("place", &Config::place, PlaceConfigFields())
+        .Nested("slam", &Config::slam, SlamConfigFields())
+        .Nested("localization", &Config::localization, LocalizerConfigFields())
+        .Nested("evaluation", &Config::evaluation, EvaluationConfigFields());
+    return table;
+  }();
+  return fields;
+}
+
+// Validates the section `key` belongs to.
+void ValidateSection(const std::string& key, const Config& config) {
+  const std::string section = key.substr(0, key.find('.'));
+  if (section == "features") ValidateFlirtConfig(config.features);
+  if (section == "odometry") ValidateScanOdometryConfig(config.odometry);
+  if (section == "mapping") Validate(config.mapping);
+  if (section == "place") Validate(config.place);
+  if (section == "slam") Validate(ToSlamConfig(config));
+  if (section == "localization") Validate(ToLocalizerConfig(config));
+  if (section == "evaluation") Validate(config.evaluation);
+}
+
+}  // namespace
+
+const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
+  using C = LocalizerConfig;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("LocalizerConfig");
+    table.Int("max_query_scans", &C::max_query_scans, "",
+              "a query submap not complete after this many scans is recognised as it stands");
+    return table;
+  }();
+  return fields;
+}
+
+const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
+  using C = EvaluationConfig;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("EvaluationConfig");
+    table
+        .Double("local_relation_max_dt_s", &C::local_relation_max_dt_s, "s",
+                "relations with |t_b - t_a| below this are local, the others loop")
+        .Int("truth_max_gap_scans", &C::truth_max_gap_scans, "",
+             "slam loops are checked when their origins are this close to a corrected scan");
+    return table;
+  }();
+  return fields;
+}
+
+void Validate(const EvaluationConfig& config) {
+  if (!(config.local_relation_max_dt_s > 0.0)) {
+    throw std::invalid_argument("EvaluationConfig.local_relation_max_dt_s must be positive");
+  }
+  if (config.truth_max_gap_scans < 0) {
+    throw std::invalid_argument("EvaluationConfig.truth_max_gap_scans must be >= 0");
+  }
+}
+
+SlamConfig ToSlamConfig(const Config& config) {
+  SlamConfig slam = config.slam;
+  slam.odometry = config.odometry;
+  slam.mapping = config.mapping;
+  slam.place = config.place;
+  return slam;
+}
+
+LocalizerConfig ToLocalizerConfig(const Config& config) {
+  LocalizerConfig localization = config.localization;
+  localization.place = config.place;
+  return localization;
+}
+
+std::vector<std::string> ConfigPresetNames() { return {"default", "paper", "strict"}; }
+
+Config PresetConfig(const std::string& name) {
+  Config config;
+  config.place = PlacePreset(name);
+  return config;
+}
+
+void Validate(const Config& config) {
+  ValidateFlirtConfig(config.features);
+  ValidateScanOdometryConfig(config.odometry);
+  Validate(config.mapping);
+  Validate(config.place);
+  Validate(ToSlamConfig(config));
+  Validate(ToLocalizerConfig(config));
+  Validate(config.evaluation);
+}
+
+std::vector<ConfigFieldInfo> DescribeConfig(const Config& config) {
+  static const Config defaults;
+  std::vector<ConfigFieldInfo> info;
+  for (const auto& field : ConfigTable().fields()) {
+    info.push_back({field.doc.name, field.doc.unit, field.doc.doc, field.get(config),
+                    field.get(defaults)});
+  }
+  return info;
+}
+
+std::vector<std::pair<std::string, std::string>> ConfigKeyValues(const Config& config) {
+  return ConfigTable().ToKeyValues(config);
+}
+
+void SetConfigValue(const std::string& key, const std::string& value, Config& config) {
+  const auto* field = ConfigTable().Find(key);
+  if (field == nullptr) throw std::invalid_argument("unknown configuration key '" + key + "'");
+  try {
+    field->set(value, config);
+    ValidateSection(key, config);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(key + ": " + error.what());
+  }
+}
+
+void ApplyConfigAssignment(const std::string& assignment, Config& config) {
+  const auto equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw std::invalid_argument("--set '" + assignment + "': expected section.key=value");
+  }
+  SetConfigValue(assignment.substr(0, equals), assignment.substr(equals + 1), config);
+}
+
+}  // namespace keyplace

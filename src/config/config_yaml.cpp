@@ -1,0 +1,107 @@
+// The configuration as YAML (yaml-cpp reads it; we write it ourselves so that every field keeps
+// its comment and the table's order).
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "keyplace/config/config.hpp"
+
+namespace keyplace {
+namespace {
+
+std::vector<std::string> SplitKey(const std::string& key) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', start)) {
+    parts.push_back(key.substr(start, dot - start));
+    start = dot + 1;
+  }
+  parts.push_back(key.substr(start));
+  return parts;
+}
+
+std::string Comment(const ConfigFieldInfo& field) {
+  std::string text = field.unit.empty() ? "" : "[" + field.unit + "] ";
+  return text + field.doc;
+}
+
+void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::string& source,
+               Config& config) {
+  const auto where = [&](const YAML::Node& at) {
+    return source + ":" + std::to_string(at.Mark().line + 1) + ": ";
+  };
+  if (!node.IsMap()) {
+    throw std::invalid_argument(where(node) + (prefix.empty() ? "the configuration" : prefix) +
+                                ": expected a mapping of keys");
+  }
+  for (const auto& entry : node) {
+    const std::string key = (prefix.empty() ? "" : prefix + ".") + entry.first.as<std::string>();
+    const YAML::Node& value = entry.second;
+    if (value.IsMap()) {
+      ApplyNode(value, key, source, config);
+    } else if (value.IsScalar()) {
+      try {
+        SetConfigValue(key, value.Scalar(), config);
+      } catch (const std::invalid_argument& error) {
+        throw std::invalid_argument(where(entry.first) + error.what());
+      }
+    } else {
+      throw std::invalid_argument(where(entry.first) + key + ": expected a value, found " +
+                                  (value.IsNull() ? "nothing" : "a list"));
+    }
+  }
+}
+
+}  // namespace
+
+std::string ConfigToYaml(const Config& config) {
+  std::ostringstream out;
+  out << "# keyplace configuration: every field with [unit] and meaning.\n"
+         "# Use with --config FILE.yaml; override one field with --set section.key=value.\n";
+  std::vector<std::string> open;  // path of the mapping being written
+  for (const ConfigFieldInfo& field : DescribeConfig(config)) {
+    std::vector<std::string> parts = SplitKey(field.key);
+    const std::string name = parts.back();
+    parts.pop_back();
+    std::size_t common = 0;
+    while (common < open.size() && common < parts.size() && open[common] == parts[common]) {
+      ++common;
+    }
+    open.resize(common);
+    for (std::size_t depth = common; depth < parts.size(); ++depth) {
+      if (depth == 0) out << '\n';
+      out << std::string(2 * depth, ' ') << parts[depth] << ":\n";
+      open.push_back(parts[depth]);
+    }
+    out << std::string(2 * parts.size(), ' ') << name << ": " << field.value << "  # "
+        << Comment(field) << '\n';
+  }
+  return out.str();
+}
+
+void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& error) {
+    throw std::invalid_argument(source + ":" + std::to_string(error.mark.line + 1) +
+                                ": malformed YAML: " + error.msg);
+  }
+  if (root.IsNull()) return;  // an empty file changes nothing
+  ApplyNode(root, "", source, config);
+}
+
+void ApplyConfigFile(const std::string& path, Config& config) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open the configuration file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  ApplyConfigYaml(text.str(), path, config);
+}
+
+}  // namespace keyplace

@@ -1,0 +1,221 @@
+#include "keyplace/eval/global_localization.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+#include "keyplace/localization/query_builder.hpp"
+
+namespace keyplace {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The evaluated scan of a query submap (its latest scan with a truth pose) and the sorted truth
+// indices of its scans.
+void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth,
+              LocalizationQuery& query, std::size_t& evaluated_position) {
+  for (std::size_t k = builder.size(); k-- > 0;) {
+    if (truth.Has(static_cast<std::size_t>(builder.scan_id(k)))) {
+      evaluated_position = k;
+      break;
+    }
+  }
+  query.evaluated_scan = builder.scan_id(evaluated_position);
+  for (std::size_t k = 0; k < builder.size(); ++k) {
+    const auto scan = static_cast<std::size_t>(builder.scan_id(k));
+    if (truth.Has(scan)) query.truth_scans.push_back(truth.truth_index_of_scan[scan]);
+  }
+  std::sort(query.truth_scans.begin(), query.truth_scans.end());
+  query.truth = truth.Pose(static_cast<std::size_t>(query.evaluated_scan));
+}
+
+}  // namespace
+
+std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos) {
+  if (n_pos < 1) throw std::invalid_argument("n_pos must be >= 1");
+  std::vector<int> eligible;
+  for (std::size_t k = 0; k < truth.truth_index_of_scan.size(); ++k) {
+    if (truth.Has(k)) eligible.push_back(static_cast<int>(k));
+  }
+  if (eligible.empty()) throw std::invalid_argument("no query scan has a ground-truth pose");
+  std::vector<int> starts;
+  for (int i = 0; i < n_pos; ++i) {
+    starts.push_back(eligible[static_cast<std::size_t>(i) * eligible.size() /
+                              static_cast<std::size_t>(n_pos)]);
+  }
+  return starts;
+}
+
+std::vector<LocalizationQuery> BuildSubmapQueries(
+    const LogInputs& inputs, const GroundTruth& truth, const MappingConfig& mapping,
+    const std::vector<int>& starts, PlaceRecognitionConfig::QueryKeypoints query_keypoints,
+    const QueryProgress& progress) {
+  const std::vector<LogScan>& scans = inputs.log.scans;
+  SubmapQueryBuilder builder(mapping);
+  std::vector<LocalizationQuery> queries;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    builder.Reset();
+    bool complete = false;
+    for (auto k = static_cast<std::size_t>(starts[i]); k < scans.size() && !complete; ++k) {
+      complete = builder.AddScan(scans[k], inputs.poses[k], inputs.keypoints[k],
+                                 static_cast<int>(k));
+    }
+    if (!complete) break;  // Algorithm 4: the log ends before the submap is complete
+    LocalizationQuery query;
+    query.start_scan = starts[i];
+    query.scans = static_cast<int>(builder.size());
+    std::size_t evaluated_position = 0;  // the start scan has a truth pose
+    SetTruth(builder, truth, query, evaluated_position);
+    query.query = builder.Query(evaluated_position, query_keypoints);
+    query.build_seconds = SecondsSince(start);
+    queries.push_back(std::move(query));
+    if (progress) progress(i + 1, starts.size());
+  }
+  return queries;
+}
+
+std::vector<LocalizationQuery> BuildScanQueries(const LogInputs& inputs, const GroundTruth& truth,
+                                                const std::vector<int>& starts) {
+  std::vector<LocalizationQuery> queries;
+  for (const int start : starts) {
+    const auto scan = static_cast<std::size_t>(start);
+    LocalizationQuery query;
+    query.start_scan = query.evaluated_scan = start;
+    query.scans = 1;
+    for (const Keypoint& keypoint : inputs.keypoints[scan]) {
+      query.query.positions.push_back(inputs.log.scans[scan].T_robot_laser * keypoint.position_m);
+      query.query.descriptors.push_back(keypoint.descriptor);
+    }
+    query.truth_scans = {truth.truth_index_of_scan[scan]};
+    query.truth = truth.Pose(scan);
+    queries.push_back(std::move(query));
+  }
+  return queries;
+}
+
+RankBy ParseRankBy(const std::string& name) {
+  if (name == "confidence") return RankBy::kConfidence;
+  if (name == "gamma") return RankBy::kGamma;
+  if (name == "consensus") return RankBy::kConsensus;
+  if (name == "score") return RankBy::kScore;
+  throw std::invalid_argument("rank-by '" + name + "': expected confidence, gamma, consensus or score");
+}
+
+std::string ToString(RankBy rank_by) {
+  switch (rank_by) {
+    case RankBy::kConfidence:
+      return "confidence";
+    case RankBy::kGamma:
+      return "gamma";
+    case RankBy::kConsensus:
+      return "consensus";
+    case RankBy::kScore:
+      return "score";
+  }
+  return "?";
+}
+
+double RankScore(RankBy rank_by, const PlaceMatch& match) {
+  switch (rank_by) {
+    case RankBy::kGamma:
+      return match.gamma;
+    case RankBy::kConsensus:
+      return match.consensus;
+    case RankBy::kScore:
+      return match.score;
+    case RankBy::kConfidence:
+      break;
+  }
+  return match.confidence;
+}
+
+std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQuery>& queries,
+                                                const PlaceRecognizer& recognizer,
+                                                SelfMatchRule rule, const QueryProgress& progress) {
+  std::vector<LocalizationRecord> records;
+  records.reserve(queries.size());
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    const LocalizationQuery& query = queries[i];
+    LocalizationRecord record;
+    record.start_scan = query.start_scan;
+    record.evaluated_scan = query.evaluated_scan;
+    record.scans = query.scans;
+    record.truth = query.truth;
+    record.build_seconds = query.build_seconds;
+    record.match = recognizer.Recognize(query.query, [&](const Place& place) {
+      return IsSelfMatch(rule, query.truth_scans, place.scan_indices);
+    });
+    record.verified_correct =
+        record.match.verified && IsCorrectPose(record.match.estimated_pose, record.truth);
+    record.correct = record.match.found && record.verified_correct;
+    records.push_back(std::move(record));
+    if (progress) progress(i + 1, queries.size());
+  }
+  return records;
+}
+
+LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, RankBy rank_by) {
+  LocalizationSummary s;
+  s.n_pos = records.size();
+  s.rank_by = rank_by;
+  double scans_correct = 0.0;
+  double scans_all = 0.0;
+  double seconds = 0.0;
+  double build_seconds = 0.0;
+  std::vector<RankedAnswer> answers;
+  for (const LocalizationRecord& r : records) {
+    seconds += r.match.seconds;
+    build_seconds += r.build_seconds;
+    scans_all += r.scans;
+    if (r.match.verified) ++s.n_verified;
+    if (r.match.ambiguous) {
+      ++s.n_ambiguous;
+      if (!r.verified_correct) ++s.n_ambiguous_wrong;
+    }
+    if (r.match.found) ++s.n_acc;
+    if (r.correct) {
+      ++s.n_cor;
+      scans_correct += r.scans;
+    }
+    answers.push_back({r.match.verified, r.verified_correct, RankScore(rank_by, r.match)});
+  }
+  const auto n = static_cast<double>(s.n_pos);
+  s.precision = s.n_acc > 0 ? static_cast<double>(s.n_cor) / static_cast<double>(s.n_acc) : 0.0;
+  s.recall = s.n_pos > 0 ? static_cast<double>(s.n_cor) / n : 0.0;
+  s.scans_mean = s.n_cor > 0 ? scans_correct / static_cast<double>(s.n_cor) : 0.0;
+  s.scans_mean_all_queries = s.n_pos > 0 ? scans_all / n : 0.0;
+  s.seconds_per_query_mean = s.n_pos > 0 ? seconds / n : 0.0;
+  s.seconds_submap_building_mean = s.n_pos > 0 ? build_seconds / n : 0.0;
+  s.curve = PrecisionRecallCurve(answers, s.n_pos);
+  s.p_gl = PrecisionAtMaxRecall(s.curve);
+  s.p_cl = RecallAtPrecision(s.curve, 0.95);
+  return s;
+}
+
+std::vector<Place> ScanPlaces(const LogInputs& map_log) {
+  std::vector<Place> places;
+  places.reserve(map_log.log.scans.size());
+  for (std::size_t k = 0; k < map_log.log.scans.size(); ++k) {
+    const LogScan& scan = map_log.log.scans[k];
+    if (!scan.corrected_pose) {
+      throw std::invalid_argument(map_log.log.path + ":" + std::to_string(scan.line) +
+                                  ": single-scan places need corrected poses");
+    }
+    Place place;
+    place.id = static_cast<int>(k);
+    place.T_world_place = *scan.corrected_pose;
+    for (const Keypoint& keypoint : map_log.keypoints[k]) {
+      place.positions.push_back(scan.T_robot_laser * keypoint.position_m);
+      place.descriptors.push_back(keypoint.descriptor);
+    }
+    place.scan_indices = {static_cast<int>(k)};
+    places.push_back(std::move(place));
+  }
+  return places;
+}
+
+}  // namespace keyplace

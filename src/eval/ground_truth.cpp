@@ -1,0 +1,70 @@
+#include "keyplace/eval/ground_truth.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace keyplace {
+
+std::size_t GroundTruth::Count() const {
+  return static_cast<std::size_t>(
+      std::count_if(truth_index_of_scan.begin(), truth_index_of_scan.end(),
+                    [](int index) { return index >= 0; }));
+}
+
+GroundTruth TruthFromOwnPoses(const CarmenLog& log) {
+  if (!log.corrected) {
+    throw std::invalid_argument(log.path +
+                                " has no corrected poses: give --truth CORRECTED_LOG and --index "
+                                "RAW_TO_CORRECTED.tsv");
+  }
+  GroundTruth truth;
+  truth.truth_log = log.path;
+  for (std::size_t k = 0; k < log.scans.size(); ++k) {
+    const LogScan& scan = log.scans[k];
+    if (!scan.corrected_pose) {
+      throw std::invalid_argument(log.path + ":" + std::to_string(scan.line) +
+                                  ": scan has no corrected pose");
+    }
+    truth.truth_poses.push_back(*scan.corrected_pose);
+    truth.truth_index_of_scan.push_back(static_cast<int>(k));
+    truth.pairs.push_back({k, k});
+  }
+  return truth;
+}
+
+GroundTruth TruthFromIndex(const CarmenLog& log, std::size_t first_scan, std::size_t file_scans,
+                           const std::string& truth_path, const std::string& index_path) {
+  const CarmenLog truth_log = ReadCarmenLogWithScans(truth_path);
+  if (!truth_log.corrected) {
+    throw std::invalid_argument(truth_path + ": --truth must be a corrected log (VERTEX2 lines)");
+  }
+  GroundTruth truth = TruthFromOwnPoses(truth_log);
+  truth.pairs.clear();
+  truth.truth_index_of_scan.assign(log.scans.size(), -1);
+  for (const IndexPair& pair : ReadIndexPairs(index_path)) {
+    if (pair.raw_index >= file_scans || pair.corrected_index >= truth.truth_poses.size()) {
+      throw std::invalid_argument(index_path + ": pair " + std::to_string(pair.raw_index) +
+                                  " -> " + std::to_string(pair.corrected_index) + " lies outside " +
+                                  log.path + " (" + std::to_string(file_scans) + " scans) or " +
+                                  truth_path + " (" + std::to_string(truth.truth_poses.size()) +
+                                  " scans)");
+    }
+    if (pair.raw_index < first_scan || pair.raw_index - first_scan >= log.scans.size()) continue;
+    const std::size_t scan = pair.raw_index - first_scan;
+    truth.truth_index_of_scan[scan] = static_cast<int>(pair.corrected_index);
+    truth.pairs.push_back({scan, pair.corrected_index});
+  }
+  return truth;
+}
+
+GroundTruth LoadGroundTruth(const CarmenLog& log, std::size_t first_scan, std::size_t file_scans,
+                            const std::string& truth_path, const std::string& index_path) {
+  if (truth_path.empty() != index_path.empty()) {
+    throw std::invalid_argument("--truth and --index must be given together");
+  }
+  if (truth_path.empty()) return TruthFromOwnPoses(log);
+  return TruthFromIndex(log, first_scan, file_scans, truth_path, index_path);
+}
+
+}  // namespace keyplace

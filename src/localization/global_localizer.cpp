@@ -1,0 +1,110 @@
+#include "keyplace/localization/global_localizer.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "keyplace/store/map_file.hpp"
+
+namespace keyplace {
+
+void Validate(const LocalizerConfig& config) {
+  Validate(config.place);
+  if (config.max_query_scans < 1) {
+    throw std::invalid_argument("LocalizerConfig.max_query_scans must be >= 1");
+  }
+}
+
+GlobalLocalizer::GlobalLocalizer(const GlobalMap& map, const LocalizerConfig& config,
+                                 const FlirtConfig& features)
+    : GlobalLocalizer(PlacesFromMap(map), map.config, config, features) {}
+
+GlobalLocalizer::GlobalLocalizer(std::vector<Place> places, const MappingConfig& mapping,
+                                 const LocalizerConfig& config, const FlirtConfig& features)
+    : config_(config),
+      mapping_config_(mapping),
+      recognizer_(std::make_shared<const PlaceRecognizer>(std::move(places), config.place)),
+      extractor_(std::make_shared<const FlirtExtractor>(features)),
+      builder_(mapping) {
+  Validate(config_);
+}
+
+GlobalLocalizer GlobalLocalizer::FromFile(const std::string& map_path,
+                                          const LocalizerConfig& config,
+                                          const FlirtConfig& features) {
+  return GlobalLocalizer(LoadMap(map_path), config, features);
+}
+
+std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan,
+                                                           const Pose2& T_odom_robot) {
+  // FLIRT's duplicate box is oriented by the laser pose (as FLIRTLib does with the log's pose).
+  return AddScan(scan, T_odom_robot, extractor_->Extract(scan, T_odom_robot * scan.T_robot_laser));
+}
+
+std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan,
+                                                           const Pose2& T_odom_robot,
+                                                           std::vector<Keypoint> keypoints,
+                                                           int scan_id) {
+  const bool complete = builder_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id);
+  if (!complete && static_cast<int>(builder_.size()) < config_.max_query_scans) {
+    return std::nullopt;
+  }
+  LocalizationResult result = Localize();
+  Reset();
+  return result;
+}
+
+std::optional<LocalizationResult> GlobalLocalizer::LocalizeNow() const {
+  if (builder_.empty()) return std::nullopt;
+  return Localize();
+}
+
+void GlobalLocalizer::Reset() { builder_.Reset(); }
+
+LocalizationResult GlobalLocalizer::Localize() const {
+  const std::size_t latest = builder_.size() - 1;
+  const PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
+  std::vector<int> scan_ids = builder_.scan_ids();
+  PlaceExclusion exclude;
+  if (exclusion_) {
+    exclude = [&](const Place& place) { return exclusion_(place, scan_ids); };
+  }
+  LocalizationResult result;
+  result.match = recognizer_->Recognize(query, exclude);
+  result.scans = builder_.size();
+  result.scan_ids = std::move(scan_ids);
+  result.T_odom_origin = builder_.pose(0);
+  result.found = result.match.found;
+  result.ambiguous = result.match.ambiguous;
+  result.confidence = result.match.confidence;
+  if (result.match.verified) {
+    result.submap_id = result.match.place_id;
+    result.T_world_robot = result.match.estimated_pose;
+    result.T_world_odom = result.T_world_robot * builder_.pose(latest).inverse();
+  }
+  return result;
+}
+
+LocalizationResult LocalizeScan(const PlaceRecognizer& recognizer, const LaserScan& scan,
+                                const std::vector<Keypoint>& keypoints, const Pose2& T_odom_robot,
+                                const PlaceExclusion& exclusion) {
+  PlaceQuery query;
+  for (const Keypoint& keypoint : keypoints) {
+    query.positions.push_back(scan.T_robot_laser * keypoint.position_m);
+    query.descriptors.push_back(keypoint.descriptor);
+  }
+  LocalizationResult result;
+  result.match = recognizer.Recognize(query, exclusion);
+  result.scans = 1;
+  result.T_odom_origin = T_odom_robot;
+  result.found = result.match.found;
+  result.ambiguous = result.match.ambiguous;
+  result.confidence = result.match.confidence;
+  if (result.match.verified) {
+    result.submap_id = result.match.place_id;
+    result.T_world_robot = result.match.estimated_pose;
+    result.T_world_odom = result.T_world_robot * T_odom_robot.inverse();
+  }
+  return result;
+}
+
+}  // namespace keyplace
