@@ -247,7 +247,7 @@ void RunOdometry(OdometryOptions options) {
   if (!options.corrected_path.empty()) {
     const CarmenLog corrected = ReadLogWithScans(options.corrected_path);
     std::vector<Pose2> corrected_poses;
-    for (const LaserScan& scan : corrected.scans) {
+    for (const LogScan& scan : corrected.scans) {
       if (!scan.corrected_pose) {
         throw std::invalid_argument(options.corrected_path + ":" + std::to_string(scan.line) +
                                     ": scan has no corrected pose");

@@ -242,7 +242,7 @@ std::string TableV() {
       mapping.max_distribution,
       static_cast<double>(mapping.min_stable_keypoints),
       static_cast<double>(place.max_candidates),
-      place.inlier_distance_m,
+      place.ransac.inlier_distance_m,
       static_cast<double>(place.min_consensus),
       500.0,  // keyplace localize --n-pos default, checked below
   };

@@ -238,7 +238,7 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
       steps.push_back({"localize-" + base + "-tip-flirt-mu5",
                        "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
                        {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
-                        "min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
+                        "place.min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
                        {log},
                        {A::TipFlirt(s, base, 5)}});
     }

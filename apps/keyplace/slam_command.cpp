@@ -63,6 +63,16 @@ struct SlamOptions {
   bool no_loop_refine = false;
 };
 
+std::map<std::string, std::string> ParseAssignments(const std::vector<std::string>& items) {
+  std::map<std::string, std::string> values;
+  for (const auto& item : items) {
+    const auto equals = item.find('=');
+    if (equals == std::string::npos) throw std::invalid_argument("--set '" + item + "'");
+    values[item.substr(0, equals)] = item.substr(equals + 1);
+  }
+  return values;
+}
+
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -99,7 +109,7 @@ void RunSlam(SlamOptions options) {
   std::vector<int> corrected_of(log.scans.size(), -1);
   if (!options.truth_path.empty()) {
     const CarmenLog corrected = ReadLogWithScans(options.truth_path);
-    for (const LaserScan& scan : corrected.scans) {
+    for (const LogScan& scan : corrected.scans) {
       if (!scan.corrected_pose) {
         throw std::invalid_argument(options.truth_path + ":" + std::to_string(scan.line) +
                                     ": scan has no corrected pose");

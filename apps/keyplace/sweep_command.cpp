@@ -2,27 +2,24 @@
 // in parallel, resumable, one result row per grid point written as soon as it finishes. The
 // place sweep evaluates Algorithm 4 through the same library calls as keyplace localize.
 
-#include <algorithm>
-#include <chrono>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include <fmt/core.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
-#include "io/file_fingerprint.hpp"
 #include "keyplace/eval/global_localization.hpp"
-#include "keyplace/mapping/global_mapper.hpp"
 #include "sweep_grid.hpp"
+#include "sweep_points.hpp"
 #include "sweep_runner.hpp"
 
 namespace keyplace::cli {
@@ -112,21 +109,6 @@ Config ResolveSweepConfig(const SweepOptions& options) {
   });
 }
 
-std::vector<double> MappingRow(const LogInputs& inputs, const MappingConfig& config) {
-  GlobalMappingTimings timings;
-  const GlobalMap map =
-      BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, config, &timings);
-  const MappingStats stats = ComputeStats(map);
-  double seconds = 0.0;
-  for (const double s : timings.submap_seconds) seconds += s;
-  const double per_submap =
-      timings.submap_seconds.empty() ? 0.0 : seconds / static_cast<double>(timings.submap_seconds.size());
-  return {static_cast<double>(stats.submaps), static_cast<double>(stats.forced_submaps),
-          stats.compression,  stats.scans_per_submap,
-          stats.distribution, stats.keypoints_per_submap,
-          static_cast<double>(stats.stable_keypoints), per_submap};
-}
-
 void RunSweepMapping(const SweepOptions& options) {
   const std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                                    {"l_g", ParseValueList(options.l_g, "--lg")}};
@@ -149,41 +131,12 @@ void RunSweepMapping(const SweepOptions& options) {
              options.log_path, inputs.log.scans.size(), ToString(inputs.pose_source), grid.size(),
              grid.size() - pending.size(),
              inputs.seconds_read + inputs.seconds_poses + inputs.seconds_keypoints);
-  RunSweepPoints(pending, results, parameters, values, options.stop_after,
-                 [&](const std::vector<double>& point) {
-                   return MappingRow(inputs, MappingConfigAt(config.mapping, point[0], point[1]));
-                 });
-  PrintSweepSummary(results, grid.size(), pending.size(), options.out_dir);
-}
-
-// The map and the Algorithm 4 queries for one mapping setting.
-struct Prepared {
-  std::vector<Place> places;
-  std::vector<LocalizationQuery> queries;
-  std::size_t submaps = 0;
-};
-
-Prepared PrepareSetting(const LogInputs& inputs, const MappingConfig& mapping, int n_pos,
-                        PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
-  const GlobalMap map = BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, mapping);
-  const GroundTruth truth = TruthFromOwnPoses(inputs.log);
-  Prepared prepared;
-  prepared.submaps = map.submaps.size();
-  prepared.places = PlacesFromMap(map);
-  prepared.queries = BuildSubmapQueries(inputs, truth, mapping, QueryStarts(truth, n_pos),
-                                        query_keypoints);
-  return prepared;
-}
-
-std::vector<double> PlaceRow(const Prepared& data, const PlaceRecognitionConfig& place,
-                             SelfMatchRule rule, RankBy rank_by) {
-  const PlaceRecognizer recognizer(data.places, place);
-  const LocalizationSummary s = Summarize(EvaluateQueries(data.queries, recognizer, rule), rank_by);
-  return {static_cast<double>(s.n_pos), static_cast<double>(s.n_acc),
-          static_cast<double>(s.n_cor), s.precision,
-          s.recall,                     s.scans_mean,
-          s.p_gl,                       s.p_cl,
-          static_cast<double>(data.submaps), s.seconds_per_query_mean};
+  const std::size_t computed = RunSweepPoints(
+      pending, results, parameters, values, options.stop_after,
+      [&](const std::vector<double>& point) {
+        return MappingSweepRow(inputs, MappingConfigAt(config.mapping, point[0], point[1]));
+      });
+  PrintSweepSummary(results, grid.size(), computed, options.out_dir);
 }
 
 void RunSweepPlace(const SweepOptions& options) {
@@ -212,8 +165,9 @@ void RunSweepPlace(const SweepOptions& options) {
                                                   : tbb::this_task_arena::max_concurrency());
   const LogInputs inputs = PrepareInputs(options, config, true);
   const std::vector<std::string> parameters{"s_min", "l_g", "mu", "gamma_min", "lambda"};
-  const std::vector<std::string> values{"n_pos",      "n_acc", "n_cor", "precision", "recall",
-                                        "scans_mean", "p_gl",  "p_cl",  "submaps",   "seconds_per_query"};
+  const std::vector<std::string> values{
+      "n_pos",      "n_acc", "n_cor", "precision", "recall",
+      "scans_mean", "p_gl",  "p_cl",  "submaps",   "seconds_per_query"};
   SweepResults results(options.out_dir, Identity("place", options, inputs, config), parameters,
                        values);
   const auto pending = PendingPoints(grid, results);
@@ -222,39 +176,17 @@ void RunSweepPlace(const SweepOptions& options) {
              inputs.seconds_read + inputs.seconds_poses + inputs.seconds_keypoints);
 
   // The map and the query submaps once per mapping setting that still has pending points.
-  std::vector<std::vector<double>> settings;
-  for (const auto& point : pending) {
-    const std::vector<double> setting{point[0], point[1]};
-    if (std::find(settings.begin(), settings.end(), setting) == settings.end()) {
-      settings.push_back(setting);
-    }
-  }
-  std::vector<Prepared> prepared(settings.size());
-  const auto map_start = std::chrono::steady_clock::now();
-  Progress map_progress("maps and queries", settings.size());
-  std::mutex map_progress_mutex;
-  std::size_t maps_done = 0;
-  tbb::parallel_for(std::size_t{0}, settings.size(), [&](std::size_t i) {
-    prepared[i] =
-        PrepareSetting(inputs, MappingConfigAt(config.mapping, settings[i][0], settings[i][1]),
-                       options.n_pos, config.place.query_keypoints);
-    const std::lock_guard<std::mutex> lock(map_progress_mutex);
-    map_progress.Update(++maps_done);
-  });
-  map_progress.Finish();
-  if (!settings.empty()) {
-    fmt::print("maps and query submaps for {} mapping settings in {:.1f} s\n", settings.size(),
-               SecondsSince(map_start));
-  }
-  RunSweepPoints(pending, results, parameters, values, options.stop_after,
-                 [&](const std::vector<double>& point) {
-                   const auto s = static_cast<std::size_t>(
-                       std::find(settings.begin(), settings.end(),
-                                 std::vector<double>{point[0], point[1]}) -
-                       settings.begin());
-                   return PlaceRow(prepared[s], PlaceConfigAt(config.place, point), rule, rank_by);
-                 });
-  PrintSweepSummary(results, grid.size(), pending.size(), options.out_dir);
+  const std::map<std::vector<double>, PlaceSweepSetting> prepared = PreparePlaceSweepSettings(
+      inputs, pending,
+      [&](double s_min, double l_g) { return MappingConfigAt(config.mapping, s_min, l_g); },
+      options.n_pos, config.place.query_keypoints);
+  const std::size_t computed =
+      RunSweepPoints(pending, results, parameters, values, options.stop_after,
+                     [&](const std::vector<double>& point) {
+                       return PlaceSweepRow(prepared.at({point[0], point[1]}),
+                                            PlaceConfigAt(config.place, point), rule, rank_by);
+                     });
+  PrintSweepSummary(results, grid.size(), computed, options.out_dir);
 }
 
 void AddCommonOptions(CLI::App* command, SweepOptions& options) {

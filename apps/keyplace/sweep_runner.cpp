@@ -21,10 +21,11 @@ std::vector<std::vector<double>> PendingPoints(const std::vector<std::vector<dou
   return pending;
 }
 
-void RunSweepPoints(const std::vector<std::vector<double>>& pending, SweepResults& results,
-                    const std::vector<std::string>& parameter_columns,
-                    const std::vector<std::string>& value_columns, int stop_after,
-                    const std::function<std::vector<double>(const std::vector<double>&)>& evaluate) {
+std::size_t RunSweepPoints(
+    const std::vector<std::vector<double>>& pending, SweepResults& results,
+    const std::vector<std::string>& parameter_columns,
+    const std::vector<std::string>& value_columns, int stop_after,
+    const std::function<std::vector<double>(const std::vector<double>&)>& evaluate) {
   std::mutex print_mutex;
   std::atomic<int> started{0};
   std::atomic<std::size_t> finished{0};
@@ -49,12 +50,13 @@ void RunSweepPoints(const std::vector<std::vector<double>>& pending, SweepResult
     progress.Update(done);
   });
   progress.Finish();
+  return finished.load();
 }
 
-void PrintSweepSummary(const SweepResults& results, std::size_t grid_size,
-                       std::size_t pending_before, const std::string& out_dir) {
+void PrintSweepSummary(const SweepResults& results, std::size_t grid_size, std::size_t computed,
+                       const std::string& out_dir) {
   fmt::print("{} rows in {}/results.csv and results.json ({} grid points, {} computed now)\n",
-             results.size(), out_dir, grid_size, pending_before);
+             results.size(), out_dir, grid_size, computed);
 }
 
 }  // namespace keyplace::cli

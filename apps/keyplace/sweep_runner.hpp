@@ -16,14 +16,16 @@ std::vector<std::vector<double>> PendingPoints(const std::vector<std::vector<dou
                                                const SweepResults& results);
 
 /// Evaluates every pending point in parallel (TBB), adding each row to `results` as it finishes.
-/// `stop_after` > 0 (a test hook) starts no new point once that many have started.
-void RunSweepPoints(const std::vector<std::vector<double>>& pending, SweepResults& results,
-                    const std::vector<std::string>& parameter_columns,
-                    const std::vector<std::string>& value_columns, int stop_after,
-                    const std::function<std::vector<double>(const std::vector<double>&)>& evaluate);
+/// `stop_after` > 0 (a test hook) starts no new point once that many have started. Returns the
+/// number of points computed.
+std::size_t RunSweepPoints(
+    const std::vector<std::vector<double>>& pending, SweepResults& results,
+    const std::vector<std::string>& parameter_columns,
+    const std::vector<std::string>& value_columns, int stop_after,
+    const std::function<std::vector<double>(const std::vector<double>&)>& evaluate);
 
-/// "N rows in DIR/results.csv and results.json (G grid points, P computed now)".
-void PrintSweepSummary(const SweepResults& results, std::size_t grid_size,
-                       std::size_t pending_before, const std::string& out_dir);
+/// "N rows in DIR/results.csv and results.json (G grid points, C computed now)".
+void PrintSweepSummary(const SweepResults& results, std::size_t grid_size, std::size_t computed,
+                       const std::string& out_dir);
 
 }  // namespace keyplace::cli

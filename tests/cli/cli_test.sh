@@ -13,7 +13,7 @@ json_value() {  # json_value FILE KEY: a top-level number or string of a JSON fi
 }
 
 check "help" "$keyplace" --help
-for command in info features odometry map localize; do
+for command in info features odometry map localize slam sweep report dump-config; do
   check "$command --help" "$keyplace" "$command" --help
 done
 
@@ -57,7 +57,7 @@ check "tip-flirt baseline" "$keyplace" localize --baseline tip-flirt --log "$log
 check "tip-flirt json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
-assert float(j['config']['min_gamma']) == 0 and j['rank_by'] == 'consensus', j['config']
+assert float(j['config']['place']['min_gamma']) == 0 and j['rank_by'] == 'consensus', j['config']
 assert j['n_pos'] == 20 and j['precision'] >= 0.9 and j['recall'] >= 0.7, j" "$work/tip.json"
 printf 'SQLite format 3\0garbage' >"$work/bad.kpm"
 fails_with "corrupt map" "bad.kpm" "$keyplace" info "$work/bad.kpm"
@@ -69,7 +69,44 @@ fails_with "bad beam count" "bad.log:1" "$keyplace" features "$work/bad.log"
 fails_with "bad scan range" "--scans" "$keyplace" features "$log" --scans 5:x
 fails_with "missing file" "does not exist" "$keyplace" info "$work/missing.log"
 fails_with "bad pose source" "--poses" "$keyplace" map "$log" --poses gps
-fails_with "bad --set key" "unknown key 'no_such'" "$keyplace" map "$log" --set no_such=1
+fails_with "bad --set key" "unknown configuration key 'mapping.no_such'" "$keyplace" map "$log" \
+  --set mapping.no_such=1
+fails_with "bad --set value" "mapping.min_scan_count: 'x' is not an integer" "$keyplace" map "$log" \
+  --set mapping.min_scan_count=x
+
+# Configuration as data: dump -> load -> dump is identical, a map built with the dumped defaults
+# is byte-identical to one built without, the map and its JSON record the whole configuration.
+check "dump-config" "$keyplace" dump-config
+"$keyplace" dump-config >"$work/defaults.yaml"
+"$keyplace" dump-config --config "$work/defaults.yaml" >"$work/defaults-again.yaml"
+check "dump-config round trip" cmp "$work/defaults.yaml" "$work/defaults-again.yaml"
+"$keyplace" dump-config --preset paper >"$work/paper.yaml"
+check "paper preset differs" grep -q "^  selection: first_verified" "$work/paper.yaml"
+check "dump-config --set" sh -c "'$keyplace' dump-config --set place.ransac.iterations=40 | grep -q '^    iterations: 40 '"
+check "map with the dumped defaults" "$keyplace" map "$log" --config "$work/defaults.yaml" \
+  --out "$work/map-config.kpm"
+check "map byte-identical with --config defaults" cmp "$work/map.kpm" "$work/map-config.kpm"
+check "map json records the configuration" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert j['config']['mapping']['cell_size_m'] == '0.1' and j['config']['place']['ransac']['iterations'] == '18', j['config']" "$work/map.json"
+check "info shows the map's configuration" sh -c "'$keyplace' info '$work/map.kpm' | grep -q '^    inlier_distance_m: 0.1 '"
+"$keyplace" map "$log" --set mapping.min_overlap=0.7 --out "$work/map-07.kpm" >/dev/null
+check "info json of a changed map" python3 -c "
+import json,subprocess,sys
+subprocess.run([sys.argv[1], 'info', sys.argv[2], '--json', sys.argv[3]], check=True, capture_output=True)
+j=json.load(open(sys.argv[3]))
+assert j['configuration']['mapping']['min_overlap'] == '0.7', j['configuration']['mapping']" \
+  "$keyplace" "$work/map-07.kpm" "$work/map07info.json"
+printf 'place:\n  min_pairs: 10\n  no_such: 3\n' >"$work/bad-key.yaml"
+fails_with "config unknown key" "bad-key.yaml:3: unknown configuration key 'place.no_such'" \
+  "$keyplace" localize --map "$work/map.kpm" --log "$log" --config "$work/bad-key.yaml"
+printf 'mapping:\n  min_overlap: high\n' >"$work/bad-type.yaml"
+fails_with "config wrong type" "bad-type.yaml:2: mapping.min_overlap: 'high' is not a number" \
+  "$keyplace" map "$log" --config "$work/bad-type.yaml"
+printf 'mapping:\n  min_overlap: 1.5\n' >"$work/bad-range.yaml"
+fails_with "config out of range" "bad-range.yaml:2: mapping.min_overlap" \
+  "$keyplace" map "$log" --config "$work/bad-range.yaml"
 
 # A failed run must not clobber an existing output file.
 echo precious >"$work/keep.json"

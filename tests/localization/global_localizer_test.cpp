@@ -1,0 +1,206 @@
+#include "keyplace/localization/global_localizer.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/eval/localization.hpp"
+#include "keyplace/mapping/global_mapper.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
+#include "place/submap_query.hpp"
+#include "support/test_data.hpp"
+
+namespace keyplace {
+namespace {
+
+// The bundled corrected FR079 log, its map (default mapping) and its keypoints, built once.
+struct Bundled {
+  LogInputs inputs;
+  GlobalMap map;
+};
+
+const Bundled& BundledLog() {
+  static const Bundled bundled = [] {
+    Bundled b;
+    b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
+    b.map = BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
+    return b;
+  }();
+  return bundled;
+}
+
+std::vector<int> SortedScans(const std::vector<int>& scans) {
+  std::vector<int> sorted = scans;
+  std::sort(sorted.begin(), sorted.end());
+  return sorted;
+}
+
+// The batch pipeline `keyplace localize` ran before the localizer existed (Algorithm 4 by hand:
+// BuildSubmap from the start scan, MakeSubmapQuery, Recognize), as the oracle.
+PlaceMatch BatchAnswer(const Bundled& b, const PlaceRecognizer& recognizer, int start_scan,
+                       bool* complete) {
+  const ScanSequence sequence{b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints};
+  LocalMapper mapper(b.map.config);
+  const std::optional<Submap> submap =
+      BuildSubmap(sequence, static_cast<std::size_t>(start_scan), mapper);
+  *complete = submap.has_value();
+  if (!submap) return {};
+  const PlaceQuery query = MakeSubmapQuery(*submap, sequence, submap->scan_indices.back(),
+                                           recognizer.config().query_keypoints);
+  const std::vector<int> scans = SortedScans(submap->scan_indices);
+  return recognizer.Recognize(query, [&](const Place& place) {
+    return IsSelfMatch(SelfMatchRule::kSameScans, scans, place.scan_indices);
+  });
+}
+
+TEST(GlobalLocalizer, StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog) {
+  const Bundled& b = BundledLog();
+  GlobalLocalizer localizer(b.map);
+  localizer.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
+    return IsSelfMatch(SelfMatchRule::kSameScans, SortedScans(query_scans), place.scan_indices);
+  });
+  const std::size_t n_scans = b.inputs.log.scans.size();
+  const int n_pos = 500;
+  int compared = 0;
+  int found = 0;
+  for (int i = 0; i < n_pos; ++i) {
+    const int start = static_cast<int>(static_cast<std::size_t>(i) * n_scans / n_pos);
+    bool complete = false;
+    const PlaceMatch batch = BatchAnswer(b, localizer.recognizer(), start, &complete);
+    localizer.Reset();
+    std::optional<LocalizationResult> streamed;
+    for (std::size_t k = static_cast<std::size_t>(start); k < n_scans && !streamed; ++k) {
+      streamed = localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k],
+                                   b.inputs.keypoints[k], static_cast<int>(k));
+    }
+    ASSERT_EQ(streamed.has_value(), complete) << "start " << start;
+    if (!complete) break;  // the log ends before the query submap is complete
+    const PlaceMatch& m = streamed->match;
+    ASSERT_EQ(m.verified, batch.verified) << "start " << start;
+    EXPECT_EQ(m.found, batch.found) << "start " << start;
+    EXPECT_EQ(m.ambiguous, batch.ambiguous) << "start " << start;
+    EXPECT_EQ(m.place_id, batch.place_id) << "start " << start;
+    EXPECT_EQ(m.consensus, batch.consensus) << "start " << start;
+    EXPECT_EQ(m.gamma, batch.gamma) << "start " << start;
+    EXPECT_EQ(m.confidence, batch.confidence) << "start " << start;
+    EXPECT_EQ(m.candidates, batch.candidates) << "start " << start;
+    EXPECT_EQ(m.estimated_pose.x, batch.estimated_pose.x) << "start " << start;
+    EXPECT_EQ(m.estimated_pose.y, batch.estimated_pose.y) << "start " << start;
+    EXPECT_EQ(m.estimated_pose.theta, batch.estimated_pose.theta) << "start " << start;
+    if (m.verified) {
+      EXPECT_EQ(streamed->submap_id, m.place_id);
+      // The robot pose is the latest scan's, and T_world_odom carries odometry into the map.
+      const Pose2 recomposed = streamed->T_world_odom * b.inputs.poses[static_cast<std::size_t>(
+                                                            streamed->scan_ids.back())];
+      EXPECT_NEAR(recomposed.x, streamed->T_world_robot.x, 1e-9);
+      EXPECT_NEAR(recomposed.y, streamed->T_world_robot.y, 1e-9);
+    }
+    found += m.found ? 1 : 0;
+    ++compared;
+  }
+  // Almost every start of the log completes a query, and most are answered (recall ~0.9).
+  EXPECT_GT(compared, 480);
+  EXPECT_GT(found, compared / 2);
+}
+
+std::size_t ResidentKiB() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t size_pages = 0;
+  std::size_t resident_pages = 0;
+  statm >> size_pages >> resident_pages;
+  return resident_pages * static_cast<std::size_t>(sysconf(_SC_PAGESIZE)) / 1024;
+}
+
+TEST(GlobalLocalizer, MemoryStaysFlatOverAnEndlessStream) {
+  const Bundled& b = BundledLog();
+  GlobalLocalizer localizer(b.map);
+  // A bound the query can never exceed: the map's forced closure (max_scans_per_submap).
+  const std::size_t bound = static_cast<std::size_t>(b.map.config.max_scans_per_submap);
+  const std::size_t slice = 600;  // the first scans, looped: a stream that never ends
+  std::size_t answers = 0;
+  std::size_t max_buffered = 0;
+  std::size_t resident_after_warmup = 0;
+  const int passes = 8;
+  for (int pass = 0; pass < passes; ++pass) {
+    // The robot drives the same stretch again and again.
+    for (std::size_t k = 0; k < slice; ++k) {
+      if (localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k])) {
+        ++answers;
+      }
+      max_buffered = std::max(max_buffered, localizer.buffered_scans());
+    }
+    if (pass == 1) resident_after_warmup = ResidentKiB();
+  }
+  EXPECT_LE(max_buffered, bound);
+  EXPECT_GT(answers, static_cast<std::size_t>(passes) * 10);
+  // Keeping every scan would add ~60 MB over these 4800 scans (ranges, keypoints, descriptors).
+  EXPECT_LT(ResidentKiB(), resident_after_warmup + 4096)
+      << "resident memory grew from " << resident_after_warmup << " KiB";
+}
+
+TEST(GlobalLocalizer, LocalizeNowAnswersFromAnIncompleteQueryAndResetForgetsIt) {
+  const Bundled& b = BundledLog();
+  GlobalLocalizer localizer(b.map);
+  EXPECT_FALSE(localizer.LocalizeNow().has_value());
+  for (std::size_t k = 100; k < 104; ++k) {
+    ASSERT_FALSE(localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]));
+  }
+  const std::optional<LocalizationResult> now = localizer.LocalizeNow();
+  ASSERT_TRUE(now.has_value());
+  EXPECT_EQ(now->scans, 4u);
+  EXPECT_EQ(localizer.buffered_scans(), 4u);  // answering now does not end the query
+  localizer.Reset();
+  EXPECT_EQ(localizer.buffered_scans(), 0u);
+  EXPECT_FALSE(localizer.LocalizeNow().has_value());
+}
+
+TEST(GlobalLocalizer, MaxQueryScansClosesAQueryThatNeverCompletes) {
+  const Bundled& b = BundledLog();
+  LocalizerConfig config;
+  config.max_query_scans = 3;
+  GlobalLocalizer localizer(b.map, config);
+  std::optional<LocalizationResult> result;
+  for (std::size_t k = 200; k < 203; ++k) {
+    result = localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]);
+  }
+  ASSERT_TRUE(result.has_value());
+  EXPECT_EQ(result->scans, 3u);
+  EXPECT_EQ(localizer.buffered_scans(), 0u);
+  config.max_query_scans = 0;
+  EXPECT_THROW(GlobalLocalizer(b.map, config), std::invalid_argument);
+}
+
+TEST(GlobalLocalizer, LocalizeScanFindsASingleScanAmongScanPlaces) {
+  const Bundled& b = BundledLog();
+  // Every 5th scan is a place; a scan between two places must be localized next to them.
+  std::vector<Place> places;
+  for (std::size_t k = 0; k < b.inputs.log.scans.size(); k += 5) {
+    Place place;
+    place.id = static_cast<int>(k);
+    place.T_world_place = b.inputs.poses[k];
+    for (const Keypoint& keypoint : b.inputs.keypoints[k]) {
+      place.positions.push_back(b.inputs.log.scans[k].T_robot_laser * keypoint.position_m);
+      place.descriptors.push_back(keypoint.descriptor);
+    }
+    place.scan_indices = {static_cast<int>(k)};
+    places.push_back(std::move(place));
+  }
+  PlaceRecognitionConfig config;
+  config.min_gamma = 0.0;
+  const PlaceRecognizer recognizer(std::move(places), config);
+  const std::size_t query = 502;
+  const LocalizationResult result =
+      LocalizeScan(recognizer, b.inputs.log.scans[query], b.inputs.keypoints[query]);
+  ASSERT_TRUE(result.match.verified);
+  EXPECT_TRUE(IsCorrectPose(result.T_world_robot, b.inputs.poses[query]));
+  EXPECT_EQ(result.scans, 1u);
+}
+
+}  // namespace
+}  // namespace keyplace
