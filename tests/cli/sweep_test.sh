@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # keyplace sweep: an interrupted sweep (a --stop-after hook, and a real kill -9 half-way) resumes
 # without redoing finished points and ends with the same table as an uninterrupted run on another
-# thread count; a different sweep in the same directory is refused; bad value lists give clear
-# errors. Usage: sweep_test.sh KEYPLACE_BINARY SOURCE_DIR
+# thread count; each interruption is checked to have come before the sweep finished (some rows
+# written, not all), else the resume would test nothing; a different sweep in the same directory
+# is refused; bad value lists give clear errors. Usage: sweep_test.sh KEYPLACE_BINARY SOURCE_DIR
 set -uo pipefail
 keyplace=$1
 source_dir=$2
@@ -30,7 +31,8 @@ for kind in place mapping; do
   # Stopped after 4 points, then resumed on 2 threads.
   "$keyplace" "${args[@]}" --threads 2 --stop-after 4 --out "$work/$kind-cut" >"$work/out1" 2>&1
   first=$(rows "$work/$kind-cut/results.csv")
-  if [ "$first" -ge 4 ] && [ "$first" -lt "$total" ]; then ok; else
+  # Exactly the 4 started points finish (no kill), and the grid must be larger than that.
+  if [ "$first" -eq 4 ] && [ "$first" -lt "$total" ]; then ok; else
     fail "$kind: --stop-after 4 left $first of $total rows"
   fi
   "$keyplace" "${args[@]}" --threads 2 --out "$work/$kind-cut" >"$work/out2" 2>&1
@@ -40,6 +42,11 @@ for kind in place mapping; do
   fi
   if [ "$(grep -c '^\[' "$work/out2")" = "$((total - first))" ]; then ok; else
     fail "$kind: resume computed $(grep -c '^\[' "$work/out2") points, expected $((total - first))"
+  fi
+  if grep -q "^$total rows in .*($total grid points, $((total - first)) computed now)" \
+    "$work/out2"; then ok; else
+    fail "$kind: resume summary is not '$total rows ... $((total - first)) computed now'"
+    tail -1 "$work/out2"
   fi
   if diff <(table "$work/$kind-ref/results.csv") <(table "$work/$kind-cut/results.csv") \
     >"$work/diff"; then ok; else
@@ -56,22 +63,38 @@ assert keys == sorted(keys), "rows not sorted"
 EOF
 done
 
-# A real interruption: kill -9 half-way through the place sweep, then resume.
+# A real interruption: kill -9 half-way through the place sweep, then resume. The kill must hit
+# the sweep while it runs (kill succeeds, the exit status is SIGKILL's) and leave rows missing.
 "$keyplace" "${place_args[@]}" --threads 1 --out "$work/killed" >/dev/null 2>&1 &
 pid=$!
 total=$(rows "$work/place-ref/results.csv")
-for _ in $(seq 1 600); do
+for _ in $(seq 1 2400); do  # up to 2 minutes on a loaded machine; half-way takes ~15 s alone
   [ -f "$work/killed/results.csv" ] && [ "$(rows "$work/killed/results.csv")" -ge $((total / 2)) ] && break
   kill -0 "$pid" 2>/dev/null || break
   sleep 0.05
 done
-kill -9 "$pid" 2>/dev/null
+if kill -9 "$pid" 2>/dev/null; then killed=yes; else killed=no; fi
 wait "$pid" 2>/dev/null
+status=$?
 before=$(rows "$work/killed/results.csv")
-echo "killed with $before of $total rows written"
+echo "killed with $before of $total rows written (kill succeeded: $killed, exit status $status)"
+if [ "$killed" = yes ] && [ "$status" -eq 137 ]; then ok; else
+  fail "kill -9 did not hit a running sweep (kill succeeded: $killed, exit status $status)"
+fi
+if [ "$before" -ge 1 ] && [ "$before" -lt "$total" ]; then ok; else
+  fail "kill -9 left $before of $total rows: it must come after the first row, before the last"
+fi
 if "$keyplace" "${place_args[@]}" --threads 2 --out "$work/killed" >"$work/out" 2>&1; then ok; else
   fail "resume after kill -9"
   cat "$work/out"
+fi
+# The resume keeps every row written before the kill and computes only the missing points.
+if grep -q "$total points, $before done before" "$work/out" &&
+  [ "$(grep -c '^\[' "$work/out")" = "$((total - before))" ] &&
+  grep -q "^$total rows in .*($total grid points, $((total - before)) computed now)" "$work/out"
+then ok; else
+  fail "resume after kill -9 at $before of $total rows: not just the $((total - before)) missing"
+  grep -v '^\[' "$work/out"
 fi
 if diff <(table "$work/place-ref/results.csv") <(table "$work/killed/results.csv") >/dev/null; then
   ok

@@ -1,6 +1,7 @@
 // Synthetic tests of the FLIRT detector, descriptor and distance.
 
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -33,6 +34,29 @@ LaserScan CornerScan(double angle_offset_rad = 0.0) {
     scan.valid.push_back(scan.ranges_m.back() < kMaxRange ? 1 : 0);
   }
   return scan;
+}
+
+// What every keypoint of `scan` must satisfy, whatever its invalid beams: it sits on a valid
+// beam (finite range in [0, max_range_m)), at that beam's endpoint, with a finite orientation
+// and scale and a normalised descriptor (no NaN leaks in from the invalid beams).
+void ExpectOnValidBeams(const LaserScan& scan, const std::vector<Keypoint>& keypoints) {
+  for (const Keypoint& k : keypoints) {
+    ASSERT_GE(k.beam_index, 0);
+    ASSERT_LT(k.beam_index, static_cast<int>(scan.size()));
+    const double range = scan.ranges_m[k.beam_index];
+    EXPECT_TRUE(std::isfinite(range) && range >= 0.0 && range < scan.max_range_m)
+        << "keypoint on beam " << k.beam_index << " of range " << range;
+    EXPECT_TRUE(k.position_m.allFinite()) << "beam " << k.beam_index;
+    EXPECT_NEAR(k.position_m.norm(), range, 1e-9);
+    EXPECT_TRUE(std::isfinite(k.orientation_rad));
+    EXPECT_TRUE(std::isfinite(k.scale_m));
+    double sum = 0.0;
+    for (const float v : k.descriptor) {
+      EXPECT_TRUE(std::isfinite(v));
+      sum += v;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+  }
 }
 
 BetaGridDescriptor Uniform() {
@@ -179,11 +203,50 @@ TEST(FlirtExtractor, DegenerateScansGiveNoKeypoints) {
   for (double& r : no_echo.ranges_m) r = 81.91;
   EXPECT_TRUE(extractor.Extract(no_echo).empty());
 
+  // Every beam invalid, as NaN or as any other invalid range: no graph vertex, no keypoint.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  LaserScan all_nan = CornerScan();
+  for (double& r : all_nan.ranges_m) r = kNaN;
+  LaserScan all_invalid = CornerScan();
+  const double invalid_ranges[] = {kNaN, kInf, -kInf, -1.0, kMaxRange, 81.91};
+  for (std::size_t i = 0; i < all_invalid.size(); ++i) {
+    all_invalid.ranges_m[i] = invalid_ranges[i % std::size(invalid_ranges)];
+  }
+  for (const LaserScan* scan : {&all_nan, &all_invalid}) {
+    std::vector<Keypoint> keypoints{Keypoint{}};
+    EXPECT_NO_THROW(keypoints = extractor.Extract(*scan));
+    EXPECT_TRUE(keypoints.empty());
+    EXPECT_TRUE(extractor.Detect(*scan).empty());
+    const FlirtSignals signals = extractor.ComputeSignals(*scan);
+    EXPECT_TRUE(signals.beam_of_vertex.empty());
+    EXPECT_TRUE(signals.vertices_m.empty());
+    EXPECT_TRUE(signals.spanning_trees.empty());
+    ASSERT_EQ(signals.peak_vertices.size(),
+              static_cast<std::size_t>(extractor.config().num_scales));
+    for (const std::vector<int>& peaks : signals.peak_vertices) EXPECT_TRUE(peaks.empty());
+  }
+
+  // Only 4 valid beams among NaNs: below the 5 the detector needs, no keypoint.
+  LaserScan four_valid = CornerScan();
+  for (std::size_t i = 0; i < four_valid.size(); ++i) {
+    if (i % 90 != 45) four_valid.ranges_m[i] = kNaN;
+  }
+  EXPECT_EQ(extractor.ComputeSignals(four_valid).beam_of_vertex,
+            (std::vector<int>{45, 135, 225, 315}));
+  EXPECT_TRUE(extractor.Extract(four_valid).empty());
+
+  // Every 40th beam kept (8 with an echo; beam 0 has none) among NaNs: the graph holds exactly
+  // those, and whatever comes out (none today) lies on them.
   LaserScan broken = CornerScan();
   for (std::size_t i = 0; i < broken.size(); ++i) {
-    if (i % 40 != 0) broken.ranges_m[i] = std::numeric_limits<double>::quiet_NaN();
+    if (i % 40 != 0) broken.ranges_m[i] = kNaN;
   }
-  EXPECT_NO_THROW(extractor.Extract(broken));
+  EXPECT_EQ(extractor.ComputeSignals(broken).beam_of_vertex,
+            (std::vector<int>{40, 80, 120, 160, 200, 240, 280, 320}));
+  std::vector<Keypoint> broken_keypoints;
+  EXPECT_NO_THROW(broken_keypoints = extractor.Extract(broken));
+  ExpectOnValidBeams(broken, broken_keypoints);
 
   LaserScan no_max_range = CornerScan();
   no_max_range.max_range_m = 0.0;
@@ -195,6 +258,43 @@ TEST(FlirtExtractor, DegenerateScansGiveNoKeypoints) {
     wall.ranges_m[i] = std::min(81.91, 3.0 / std::cos(wall.angles_rad[i]));
   }
   for (const Keypoint& k : extractor.Extract(wall)) EXPECT_GT(k.position_m.norm(), 5.0);
+}
+
+TEST(FlirtExtractor, NanBeamsAreLeftOutAndTheCornerIsStillFound) {
+  // Every third beam of the corner scan is NaN (a driver's "no reading"): those beams are not
+  // graph vertices, no keypoint lies on one, and the corner is still found. NaN beams weigh in
+  // the graph exactly as no-return beams do: the detector signals are identical.
+  const FlirtExtractor extractor;
+  LaserScan scan = CornerScan();
+  LaserScan no_return = CornerScan();
+  std::vector<int> valid_beams;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (i % 3 == 1) {
+      scan.ranges_m[i] = std::numeric_limits<double>::quiet_NaN();
+      no_return.ranges_m[i] = 81.91;
+    } else if (scan.ranges_m[i] < kMaxRange) {
+      valid_beams.push_back(static_cast<int>(i));
+    }
+  }
+  const FlirtSignals signals = extractor.ComputeSignals(scan);
+  EXPECT_EQ(signals.beam_of_vertex, valid_beams);
+  const FlirtSignals no_return_signals = extractor.ComputeSignals(no_return);
+  EXPECT_EQ(signals.beam_of_vertex, no_return_signals.beam_of_vertex);
+  EXPECT_EQ(signals.signal, no_return_signals.signal);
+  EXPECT_EQ(signals.peak_vertices, no_return_signals.peak_vertices);
+  for (const std::vector<double>& level : signals.signal) {
+    for (const double v : level) EXPECT_TRUE(std::isfinite(v));
+  }
+
+  const std::vector<Keypoint> keypoints = extractor.Extract(scan);
+  ASSERT_FALSE(keypoints.empty());
+  ExpectOnValidBeams(scan, keypoints);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Keypoint& k : keypoints) {
+    EXPECT_NE(k.beam_index % 3, 1) << "keypoint on NaN beam " << k.beam_index;
+    nearest = std::min(nearest, (k.position_m - Eigen::Vector2d(4.0, 2.0)).norm());
+  }
+  EXPECT_LT(nearest, 0.1);
 }
 
 TEST(FlirtExtractor, MismatchedScanThrows) {
