@@ -14,7 +14,7 @@
 
 #include <fmt/core.h>
 
-#include "cli_support.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/local_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
@@ -110,7 +110,8 @@ Surface NewSurface(int width, int height) {
 StabilityFigureSummary DrawStabilityFigures(const std::string& log_path, std::size_t first_scan,
                                             const std::string& fig6_png,
                                             const std::string& fig7_png) {
-  CarmenLog log = ReadLogWithScans(log_path);
+  CarmenLog log = ReadCarmenLog(log_path);
+  if (log.scans.empty()) throw std::invalid_argument(log_path + ": no laser scans");
   if (!log.corrected) {
     throw std::invalid_argument(log_path + ": the stability figures need a corrected log");
   }
