@@ -48,7 +48,7 @@ format-check:
 	@echo "format-check: clang-format clean"
 
 tidy: configure
-	@git ls-files 'src/*.cpp' 'apps/*.cpp' | xargs -P $(JOBS) -n 4 clang-tidy -p $(BUILD_DIR) --quiet 2>/dev/null
+	@git ls-files 'src/*.cpp' 'apps/*.cpp' 'tools/*.cpp' 'examples/*.cpp' | xargs -P $(JOBS) -n 4 clang-tidy -p $(BUILD_DIR) --quiet 2>/dev/null
 	@echo "tidy: clang-tidy clean"
 
 install: build

@@ -14,7 +14,7 @@
 
 #include <fmt/core.h>
 
-#include "cli_support.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/local_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
@@ -110,21 +110,15 @@ Surface NewSurface(int width, int height) {
 StabilityFigureSummary DrawStabilityFigures(const std::string& log_path, std::size_t first_scan,
                                             const std::string& fig6_png,
                                             const std::string& fig7_png) {
-  CarmenLog log = ReadLogWithScans(log_path);
-  if (!log.corrected) {
-    throw std::invalid_argument(log_path + ": the stability figures need a corrected log");
-  }
-  if (first_scan >= log.scans.size()) {
-    throw std::invalid_argument(
-        fmt::format("{}: scan {} is beyond its {} scans", log_path, first_scan, log.scans.size()));
-  }
   // Only the scans a submap can take: keypoints of the whole log are not needed.
-  const std::size_t end = std::min(log.scans.size(), first_scan + kMaxScans);
-  log.scans = std::vector<LogScan>(log.scans.begin() + static_cast<std::ptrdiff_t>(first_scan),
-                                     log.scans.begin() + static_cast<std::ptrdiff_t>(end));
-  const std::vector<Pose2> poses = ScanPoses(log, PoseSource::kCorrected);
-  const FlirtExtractor extractor;
-  const std::vector<std::vector<Keypoint>> keypoints = ExtractKeypoints(log, extractor);
+  LogInputOptions options;
+  options.poses = PoseSource::kCorrected;
+  options.first_scan = first_scan;
+  options.end_scan = first_scan + kMaxScans;
+  const LogInputs inputs = PrepareLogInputs(log_path, options);
+  const CarmenLog& log = inputs.log;
+  const std::vector<Pose2>& poses = inputs.poses;
+  const std::vector<std::vector<Keypoint>>& keypoints = inputs.keypoints;
   const MappingConfig config;
   LocalMapper mapper(config);
   const std::optional<Submap> submap = BuildSubmap({log.scans, poses, keypoints}, 0, mapper);
