@@ -35,9 +35,8 @@ int main(int argc, char** argv) {
       if (!result || !result->found) continue;
       ++fixes;
       const keyplace::Pose2& pose = result->T_world_robot;
-      std::printf("scan %5zu  x %8.3f m  y %8.3f m  theta %7.2f deg  confidence %.2f  submap %d",
-                  k, pose.x, pose.y, pose.theta * 180.0 / M_PI, result->confidence,
-                  result->submap_id);
+      std::printf("scan %5zu  x %8.3f m  y %8.3f m  theta %7.2f deg  confidence %.2f  submap %d", k,
+                  pose.x, pose.y, pose.theta * 180.0 / M_PI, result->confidence, result->submap_id);
       if (check_truth && scan.corrected_pose) {
         const bool ok = keyplace::IsCorrectPose(pose, *scan.corrected_pose);
         correct += ok ? 1 : 0;

@@ -64,9 +64,8 @@ void SubmapColour(cairo_t* cr, int id) {
 
 }  // namespace
 
-void DrawMapFigure(const std::string& path, const GlobalMap& map,
-                   const std::vector<LogScan>& scans, const std::vector<Pose2>& poses,
-                   const MapFigureOptions& options) {
+void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vector<LogScan>& scans,
+                   const std::vector<Pose2>& poses, const MapFigureOptions& options) {
   const bool svg = EndsWith(path, ".svg");
   if (!svg && !EndsWith(path, ".png")) {
     throw std::invalid_argument(path + ": figure file name must end in .png or .svg");

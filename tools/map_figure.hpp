@@ -18,8 +18,7 @@ struct MapFigureOptions {
 
 /// Draws the map; the format follows the extension of `path` (.png or .svg). `poses` are the
 /// T_world_robot of `scans` (may be empty to draw keypoints only). Written atomically.
-void DrawMapFigure(const std::string& path, const GlobalMap& map,
-                   const std::vector<LogScan>& scans, const std::vector<Pose2>& poses,
-                   const MapFigureOptions& options);
+void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vector<LogScan>& scans,
+                   const std::vector<Pose2>& poses, const MapFigureOptions& options);
 
 }  // namespace keyplace::cli

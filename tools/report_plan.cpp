@@ -235,12 +235,13 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
                         "--json", A::TipFlirt(s, base)},
                        {log},
                        {A::TipFlirt(s, base)}});
-      steps.push_back({"localize-" + base + "-tip-flirt-mu5",
-                       "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
-                       {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
-                        "place.min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
-                       {log},
-                       {A::TipFlirt(s, base, 5)}});
+      steps.push_back(
+          {"localize-" + base + "-tip-flirt-mu5",
+           "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
+           {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
+            "place.min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
+           {log},
+           {A::TipFlirt(s, base, 5)}});
     }
     // Figure 8: mapping criteria over s_min x l_g.
     const std::string fig8 = A::Fig8Dir(s, base);

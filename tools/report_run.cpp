@@ -9,7 +9,7 @@
 
 #include <fmt/core.h>
 
-#include "keyplace/io/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "report_context.hpp"
 #include "report_page.hpp"
 

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
-#include "config_options.hpp"
 #include "commands.hpp"
+#include "config_options.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/store/map_file.hpp"

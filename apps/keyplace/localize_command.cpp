@@ -54,7 +54,8 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
     aliases.push_back(fmt::format("place.min_gamma_all_scans={}", *o.gamma_min));
   }
   if (o.lambda) aliases.push_back(fmt::format("place.double_match_m={}", *o.lambda));
-  if (o.min_confidence) aliases.push_back(fmt::format("place.min_confidence={}", *o.min_confidence));
+  if (o.min_confidence)
+    aliases.push_back(fmt::format("place.min_confidence={}", *o.min_confidence));
   return aliases;
 }
 
@@ -86,7 +87,8 @@ void RunLocalize(const LocalizeOptions& options) {
   const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
                                             options.truth_path, options.index_path);
-  const std::string map_log_path = options.truth_path.empty() ? options.log_path : options.truth_path;
+  const std::string map_log_path =
+      options.truth_path.empty() ? options.log_path : options.truth_path;
   const std::vector<int> starts = QueryStarts(truth, options.n_pos);
 
   std::vector<Place> places;
@@ -108,7 +110,8 @@ void RunLocalize(const LocalizeOptions& options) {
     const LogInputs map_log =
         options.truth_path.empty() ? inputs : PrepareLogInputs(options.truth_path, map_options);
     places = ScanPlaces(map_log);
-    map_description = fmt::format("TIP-FLIRT: {} scans of {} as places", places.size(), map_log_path);
+    map_description =
+        fmt::format("TIP-FLIRT: {} scans of {} as places", places.size(), map_log_path);
     queries = BuildScanQueries(inputs, truth, starts);
   }
   const double preparation_seconds = SecondsSince(start);

@@ -30,8 +30,8 @@ std::string DatasetOf(const std::string& log_path) {
 }
 
 const PaperLocalizationRow* PaperRow(const LocalizeReport& r) {
-  const bool paper_setting = !r.baseline && r.place.min_pairs == 10 &&
-                             std::abs(r.place.min_gamma - 0.4) < 1e-9;
+  const bool paper_setting =
+      !r.baseline && r.place.min_pairs == 10 && std::abs(r.place.min_gamma - 0.4) < 1e-9;
   return paper_setting ? PaperLocalization(DatasetOf(r.log_path), r.place.double_match_m) : nullptr;
 }
 
@@ -153,7 +153,8 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["p_cl"] = s.p_cl;
   json["curve"] = CurveJson(s.curve);
   nlohmann::json others;
-  for (const RankBy key : {RankBy::kGamma, RankBy::kConfidence, RankBy::kConsensus, RankBy::kScore}) {
+  for (const RankBy key :
+       {RankBy::kGamma, RankBy::kConfidence, RankBy::kConsensus, RankBy::kScore}) {
     const LocalizationSummary ranked = Summarize(records, key);
     others[ToString(key)] = {{"p_gl", ranked.p_gl}, {"p_cl", ranked.p_cl}};
   }

@@ -13,8 +13,8 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
-#include "keyplace/io/carmen_log.hpp"
 #include "io/file_fingerprint.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
@@ -56,9 +56,9 @@ void RunMap(const MapOptions& options) {
 
   Progress map_progress("mapping", log.scans.size());
   GlobalMappingTimings timings;
-  GlobalMap map = BuildGlobalMap({log.scans, inputs.poses, inputs.keypoints}, config.mapping,
-                                 &timings,
-                                 [&](std::size_t next_scan) { map_progress.Update(next_scan); });
+  GlobalMap map =
+      BuildGlobalMap({log.scans, inputs.poses, inputs.keypoints}, config.mapping, &timings,
+                     [&](std::size_t next_scan) { map_progress.Update(next_scan); });
   map_progress.Finish();
   map.source_log = inputs.source_log;
   map.source_hash = inputs.source_hash;

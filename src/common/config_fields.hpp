@@ -79,7 +79,8 @@ class ConfigFields {
   ConfigFields& Enum(const char* name, EnumType Config::*member,
                      std::vector<std::pair<EnumType, const char*>> names, const char* doc) {
     std::string values;
-    for (const auto& entry : names) values += (values.empty() ? "" : " | ") + std::string(entry.second);
+    for (const auto& entry : names)
+      values += (values.empty() ? "" : " | ") + std::string(entry.second);
     return Add(
         {name, "", std::string(doc) + " (" + values + ")"},
         [member, names](const Config& c) {

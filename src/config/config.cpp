@@ -108,8 +108,8 @@ std::vector<ConfigFieldInfo> DescribeConfig(const Config& config) {
   static const Config defaults;
   std::vector<ConfigFieldInfo> info;
   for (const auto& field : ConfigTable().fields()) {
-    info.push_back({field.doc.name, field.doc.unit, field.doc.doc, field.get(config),
-                    field.get(defaults)});
+    info.push_back(
+        {field.doc.name, field.doc.unit, field.doc.doc, field.get(config), field.get(defaults)});
   }
   return info;
 }

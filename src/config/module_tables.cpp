@@ -80,7 +80,8 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
         .Int("local_map_scans", &C::local_map_scans, "", "key scans in the local map")
         .Double("keyframe_translation_m", &C::keyframe_translation_m, "m",
                 "a scan becomes a key scan after moving this far ...")
-        .Double("keyframe_rotation_rad", &C::keyframe_rotation_rad, "rad", "... or turning this much")
+        .Double("keyframe_rotation_rad", &C::keyframe_rotation_rad, "rad",
+                "... or turning this much")
         .Double("max_correction_translation_m", &C::max_correction_translation_m, "m",
                 "ICP results further than this from the odometry prediction are rejected ...")
         .Double("max_correction_rotation_rad", &C::max_correction_rotation_rad, "rad",

@@ -15,8 +15,8 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 // The evaluated scan of a query submap (its latest scan with a truth pose) and the sorted truth
 // indices of its scans.
-void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth,
-              LocalizationQuery& query, std::size_t& evaluated_position) {
+void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth, LocalizationQuery& query,
+              std::size_t& evaluated_position) {
   for (std::size_t k = builder.size(); k-- > 0;) {
     if (truth.Has(static_cast<std::size_t>(builder.scan_id(k)))) {
       evaluated_position = k;
@@ -43,8 +43,8 @@ std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos) {
   if (eligible.empty()) throw std::invalid_argument("no query scan has a ground-truth pose");
   std::vector<int> starts;
   for (int i = 0; i < n_pos; ++i) {
-    starts.push_back(eligible[static_cast<std::size_t>(i) * eligible.size() /
-                              static_cast<std::size_t>(n_pos)]);
+    starts.push_back(
+        eligible[static_cast<std::size_t>(i) * eligible.size() / static_cast<std::size_t>(n_pos)]);
   }
   return starts;
 }
@@ -61,8 +61,8 @@ std::vector<LocalizationQuery> BuildSubmapQueries(
     builder.Reset();
     bool complete = false;
     for (auto k = static_cast<std::size_t>(starts[i]); k < scans.size() && !complete; ++k) {
-      complete = builder.AddScan(scans[k], inputs.poses[k], inputs.keypoints[k],
-                                 static_cast<int>(k));
+      complete =
+          builder.AddScan(scans[k], inputs.poses[k], inputs.keypoints[k], static_cast<int>(k));
     }
     if (!complete) break;  // Algorithm 4: the log ends before the submap is complete
     LocalizationQuery query;
@@ -102,7 +102,8 @@ RankBy ParseRankBy(const std::string& name) {
   if (name == "gamma") return RankBy::kGamma;
   if (name == "consensus") return RankBy::kConsensus;
   if (name == "score") return RankBy::kScore;
-  throw std::invalid_argument("rank-by '" + name + "': expected confidence, gamma, consensus or score");
+  throw std::invalid_argument("rank-by '" + name +
+                              "': expected confidence, gamma, consensus or score");
 }
 
 std::string ToString(RankBy rank_by) {

@@ -7,9 +7,9 @@
 namespace keyplace {
 
 std::size_t GroundTruth::Count() const {
-  return static_cast<std::size_t>(
-      std::count_if(truth_index_of_scan.begin(), truth_index_of_scan.end(),
-                    [](int index) { return index >= 0; }));
+  return static_cast<std::size_t>(std::count_if(truth_index_of_scan.begin(),
+                                                truth_index_of_scan.end(),
+                                                [](int index) { return index >= 0; }));
 }
 
 GroundTruth TruthFromOwnPoses(const CarmenLog& log) {
@@ -44,8 +44,8 @@ GroundTruth TruthFromIndex(const CarmenLog& log, std::size_t first_scan, std::si
   truth.truth_index_of_scan.assign(log.scans.size(), -1);
   for (const IndexPair& pair : ReadIndexPairs(index_path)) {
     if (pair.raw_index >= file_scans || pair.corrected_index >= truth.truth_poses.size()) {
-      throw std::invalid_argument(index_path + ": pair " + std::to_string(pair.raw_index) +
-                                  " -> " + std::to_string(pair.corrected_index) + " lies outside " +
+      throw std::invalid_argument(index_path + ": pair " + std::to_string(pair.raw_index) + " -> " +
+                                  std::to_string(pair.corrected_index) + " lies outside " +
                                   log.path + " (" + std::to_string(file_scans) + " scans) or " +
                                   truth_path + " (" + std::to_string(truth.truth_poses.size()) +
                                   " scans)");

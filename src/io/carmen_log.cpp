@@ -357,7 +357,8 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
 CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options) {
   CarmenLog log = ReadCarmenLog(path, options);
   if (log.scans.empty()) {
-    throw std::invalid_argument(path + ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
+    throw std::invalid_argument(path +
+                                ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
                                 std::to_string(log.lines) + " lines: is this a CARMEN log?");
   }
   return log;

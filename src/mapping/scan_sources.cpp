@@ -104,8 +104,8 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   inputs.seconds_read = SecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  inputs.pose_source = options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected
-                                                                   : PoseSource::kIcp);
+  inputs.pose_source =
+      options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected : PoseSource::kIcp);
   const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
   inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
                            [&](std::size_t done, std::size_t total) {
@@ -116,9 +116,10 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   if (options.keypoints) {
     start = std::chrono::steady_clock::now();
     const FlirtExtractor extractor(options.features);
-    inputs.keypoints = ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
-      if (progress) progress("keypoints", done, total);
-    });
+    inputs.keypoints =
+        ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
+          if (progress) progress("keypoints", done, total);
+        });
     inputs.seconds_keypoints = SecondsSince(start);
   }
   return inputs;

@@ -26,7 +26,8 @@ const ConfigFields<RansacConfig>& RansacConfigFields() {
         .Int("exhaustive_max_pairs", &C::exhaustive_max_pairs, "",
              "enumerate every pair of descriptor pairs up to this many pairs (0 = always sample)")
         .Double("rigidity_m2", &C::rigidity_m2, "m^2", "FLIRTLib's rigidity pre-check of a sample")
-        .Bool("refine", &C::refine, "least-squares refit on the inliers, kept when it scores better")
+        .Bool("refine", &C::refine,
+              "least-squares refit on the inliers, kept when it scores better")
         .Int("seed", &C::seed, "", "random seed, combined with the place id");
     return table;
   }();
@@ -83,9 +84,11 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
         .Double("distinct_distance_m", &C::distinct_distance_m, "m",
                 "two verified candidates are distinct beyond this distance ...")
         .Double("distinct_angle_deg", &C::distinct_angle_deg, "deg", "... or this angle")
-        .Double("ambiguity_ratio", &C::ambiguity_ratio, "",
-                "ambiguous when a distinct candidate scores this fraction of the best (>= 1: never)")
-        .Double("min_confidence", &C::min_confidence, "", "answers below this confidence are refused")
+        .Double(
+            "ambiguity_ratio", &C::ambiguity_ratio, "",
+            "ambiguous when a distinct candidate scores this fraction of the best (>= 1: never)")
+        .Double("min_confidence", &C::min_confidence, "",
+                "answers below this confidence are refused")
         .Int("confidence_consensus", &C::confidence_consensus, "",
              "consensus at which the confidence's consensus factor saturates");
     return table;

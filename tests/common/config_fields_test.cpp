@@ -80,7 +80,8 @@ struct Outer {
 const ConfigFields<Outer>& OuterFields() {
   static const ConfigFields<Outer> fields = [] {
     ConfigFields<Outer> table("Outer");
-    table.Double("scale_m", &Outer::scale_m, "m", "a scale").Nested("inner", &Outer::inner, Fields());
+    table.Double("scale_m", &Outer::scale_m, "m", "a scale")
+        .Nested("inner", &Outer::inner, Fields());
     return table;
   }();
   return fields;

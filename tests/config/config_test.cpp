@@ -86,7 +86,8 @@ TEST(Config, BadFilesNameFileLineAndKey) {
             "my.yaml:3: slam.loop_refinement.refine: 'maybe' is not true or false");
   EXPECT_EQ(ErrorOfYaml("place:\n  selection: best\n"),
             "my.yaml:2: place.selection: 'best' is not one of first_verified | best_score");
-  EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs:\n"), "my.yaml:2: place.min_pairs: expected a value, found nothing");
+  EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs:\n"),
+            "my.yaml:2: place.min_pairs: expected a value, found nothing");
   EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs: [1, 2]\n"),
             "my.yaml:2: place.min_pairs: expected a value, found a list");
   EXPECT_EQ(ErrorOfYaml("odometry: 3\n"), "my.yaml:1: unknown configuration key 'odometry'");

@@ -29,7 +29,8 @@ const Bundled& BundledLog() {
   static const Bundled bundled = [] {
     Bundled b;
     b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
-    b.map = BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
+    b.map =
+        BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
     return b;
   }();
   return bundled;
@@ -76,8 +77,8 @@ TEST(GlobalLocalizer, StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog) {
     localizer.Reset();
     std::optional<LocalizationResult> streamed;
     for (std::size_t k = static_cast<std::size_t>(start); k < n_scans && !streamed; ++k) {
-      streamed = localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k],
-                                   b.inputs.keypoints[k], static_cast<int>(k));
+      streamed = localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k],
+                                   static_cast<int>(k));
     }
     ASSERT_EQ(streamed.has_value(), complete) << "start " << start;
     if (!complete) break;  // the log ends before the query submap is complete
@@ -96,8 +97,8 @@ TEST(GlobalLocalizer, StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog) {
     if (m.verified) {
       EXPECT_EQ(streamed->submap_id, m.place_id);
       // The robot pose is the latest scan's, and T_world_odom carries odometry into the map.
-      const Pose2 recomposed = streamed->T_world_odom * b.inputs.poses[static_cast<std::size_t>(
-                                                            streamed->scan_ids.back())];
+      const Pose2 recomposed = streamed->T_world_odom *
+                               b.inputs.poses[static_cast<std::size_t>(streamed->scan_ids.back())];
       EXPECT_NEAR(recomposed.x, streamed->T_world_robot.x, 1e-9);
       EXPECT_NEAR(recomposed.y, streamed->T_world_robot.y, 1e-9);
     }
@@ -149,7 +150,8 @@ TEST(GlobalLocalizer, LocalizeNowAnswersFromAnIncompleteQueryAndResetForgetsIt) 
   GlobalLocalizer localizer(b.map);
   EXPECT_FALSE(localizer.LocalizeNow().has_value());
   for (std::size_t k = 100; k < 104; ++k) {
-    ASSERT_FALSE(localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]));
+    ASSERT_FALSE(
+        localizer.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]));
   }
   const std::optional<LocalizationResult> now = localizer.LocalizeNow();
   ASSERT_TRUE(now.has_value());

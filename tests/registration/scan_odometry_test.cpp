@@ -134,8 +134,10 @@ TEST(ScanOdometryTest, EmptyScanFallsBackToOdometryAndIsFlagged) {
   LaserScan empty;
   EXPECT_EQ(fresh.Add(empty, std::nullopt).status, ScanOdometryStatus::kFirstScan);
   EXPECT_EQ(fresh.Add(empty, std::nullopt).status, ScanOdometryStatus::kFallbackTooFewPoints);
-  EXPECT_EQ(fresh.Add(drive.scans[0], drive.scans[0].odometry_pose).status, ScanOdometryStatus::kFallbackTooFewPoints);
-  EXPECT_EQ(fresh.Add(drive.scans[1], drive.scans[1].odometry_pose).status, ScanOdometryStatus::kRegistered);
+  EXPECT_EQ(fresh.Add(drive.scans[0], drive.scans[0].odometry_pose).status,
+            ScanOdometryStatus::kFallbackTooFewPoints);
+  EXPECT_EQ(fresh.Add(drive.scans[1], drive.scans[1].odometry_pose).status,
+            ScanOdometryStatus::kRegistered);
 }
 
 TEST(ScanOdometryTest, InvalidConfigThrowsNamingTheField) {

@@ -19,14 +19,14 @@
 namespace keyplace {
 
 struct Config {
-  FlirtConfig features;                // FLIRT keypoints (docs/FLIRT.md)
-  ScanOdometryConfig odometry;         // ICP scan odometry (docs/REGISTRATION.md)
-  MappingConfig mapping;               // stable-keypoint submaps (docs/MAPPING.md)
-  PlaceRecognitionConfig place;        // recognition of submaps (docs/PLACE.md)
-  SlamConfig slam;                     // loop closure and pose graph (docs/SLAM.md); its
-                                       // odometry, mapping and place are the sections above
-  LocalizerConfig localization;        // streaming localizer; its place is the section above
-  EvaluationConfig evaluation;         // evaluation settings (not the method's)
+  FlirtConfig features;          // FLIRT keypoints (docs/FLIRT.md)
+  ScanOdometryConfig odometry;   // ICP scan odometry (docs/REGISTRATION.md)
+  MappingConfig mapping;         // stable-keypoint submaps (docs/MAPPING.md)
+  PlaceRecognitionConfig place;  // recognition of submaps (docs/PLACE.md)
+  SlamConfig slam;               // loop closure and pose graph (docs/SLAM.md); its
+                                 // odometry, mapping and place are the sections above
+  LocalizerConfig localization;  // streaming localizer; its place is the section above
+  EvaluationConfig evaluation;   // evaluation settings (not the method's)
 };
 
 /// The SLAM configuration with the odometry, mapping and place sections put in.

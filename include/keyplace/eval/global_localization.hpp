@@ -75,11 +75,11 @@ struct LocalizationSummary {
   std::size_t n_verified = 0;
   std::size_t n_ambiguous = 0;
   std::size_t n_ambiguous_wrong = 0;
-  double precision = 0.0;  // n_cor / n_acc (0 when nothing was accepted)
-  double recall = 0.0;     // n_cor / n_pos
-  double scans_mean = 0.0;               // scans of the correctly answered queries
+  double precision = 0.0;   // n_cor / n_acc (0 when nothing was accepted)
+  double recall = 0.0;      // n_cor / n_pos
+  double scans_mean = 0.0;  // scans of the correctly answered queries
   double scans_mean_all_queries = 0.0;
-  double seconds_per_query_mean = 0.0;   // recognition
+  double seconds_per_query_mean = 0.0;  // recognition
   double seconds_submap_building_mean = 0.0;
   RankBy rank_by = RankBy::kConfidence;
   std::vector<PrPoint> curve;  // ranked by rank_by

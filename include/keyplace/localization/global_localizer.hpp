@@ -23,8 +23,8 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/laser_scan.hpp"
-#include "keyplace/mapping/global_map.hpp"
 #include "keyplace/localization/query_builder.hpp"
+#include "keyplace/mapping/global_map.hpp"
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 
