@@ -132,11 +132,12 @@ TEST(GlobalMapper, SubmapsAreConsecutiveAndStopAtTheEnd) {
   MappingConfig config;
   config.use_distribution = false;
   config.min_stable_keypoints = 0;
-  std::vector<LaserScan> scans;
+  std::vector<LogScan> scans;
   std::vector<Pose2> poses;
   for (int k = 0; k < 80; ++k) {
     poses.emplace_back(-8.0 + 0.2 * k, 0.0, 0.0);
-    scans.push_back(SquareRoomScan(poses.back(), 10.0, 180));
+    scans.emplace_back();
+    static_cast<LaserScan&>(scans.back()) = SquareRoomScan(poses.back(), 10.0, 180);
   }
   const std::vector<std::vector<Keypoint>> keypoints(scans.size());
   const ScanSequence sequence{scans, poses, keypoints};
