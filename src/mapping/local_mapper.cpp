@@ -11,7 +11,7 @@ namespace {
 std::int64_t DistributionKey(const Eigen::Vector2d& point_m, double cell_m) {
   const auto i = static_cast<std::int64_t>(std::floor(point_m.x() / cell_m));
   const auto j = static_cast<std::int64_t>(std::floor(point_m.y() / cell_m));
-  return (i << 32) ^ static_cast<std::uint32_t>(j);
+  return CellKey(static_cast<int>(i), static_cast<int>(j));
 }
 
 // delta from the two sets of occupied cells of D; every keypoint cell normally holds laser

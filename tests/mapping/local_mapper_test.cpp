@@ -54,6 +54,15 @@ TEST(DistributionDistance, HandComputedCases) {
   EXPECT_NEAR(DistributionDistance(laser, {{10.0, 10.0}}, 0.5, kPoints), 1.0, 1e-12);
 }
 
+TEST(DistributionDistance, NegativeCellsAreTheirOwnCells) {
+  // Cells (-1, -1), (-1, 0), (0, -1) and (0, 0) around the origin (their keys once needed a left
+  // shift of a negative value). One keypoint cell among four: as in HandComputedCases, 0.6.
+  const std::vector<Eigen::Vector2d> laser = {{-0.2, -0.2}, {-0.2, 0.2}, {0.2, -0.2}, {0.2, 0.2}};
+  constexpr auto kCells = MappingConfig::DistributionNormalization::kCells;
+  EXPECT_NEAR(DistributionDistance(laser, {{-0.3, -0.1}}, 0.5, kCells), 0.6, 1e-12);
+  EXPECT_NEAR(DistributionDistance(laser, laser, 0.5, kCells), 0.0, 1e-12);
+}
+
 class OverlapTest : public ::testing::TestWithParam<MappingConfig::OverlapCells> {};
 
 TEST_P(OverlapTest, OverlapFallsAsTheRobotMovesAndCompletesBelowRhoMin) {

@@ -1,5 +1,9 @@
 #include "keyplace/mapping/stability_grid.hpp"
 
+#include <cstdint>
+#include <limits>
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include "keyplace/features/descriptor.hpp"
@@ -185,6 +189,37 @@ TEST(StabilityGrid, LatestMemberMatchingComparesOnlyTheNewestKeypoint) {
   any.InsertKeypoint(At(0.5, 0.5, 3, d));
   EXPECT_EQ(latest.Clusters({0, 0}).size(), 2u);
   EXPECT_EQ(any.Clusters({0, 0}).size(), 1u);
+}
+
+// Evaluated by the compiler: undefined behaviour is a compile error in a constant expression, so
+// the former `(std::int64_t{i} << 32) ^ std::uint32_t(j)` (a left shift of a negative value)
+// does not compile here. The values are those of the former key (maps stay byte-identical).
+static_assert(CellKey(0, 0) == 0);
+static_assert(CellKey(3, 5) == (std::int64_t{3} << 32) + 5);
+static_assert(CellKey(0, -1) == 0xFFFFFFFFLL);
+static_assert(CellKey(-1, 0) == static_cast<std::int64_t>(0xFFFFFFFF00000000ULL));
+static_assert(CellKey(-1, -1) == -1);
+static_assert(CellKey(-2, 7) == static_cast<std::int64_t>(0xFFFFFFFE00000007ULL));
+static_assert(CellKey(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()) ==
+              static_cast<std::int64_t>(0x800000007FFFFFFFULL));
+
+TEST(StabilityGrid, NegativeCellsHaveDistinctKeysAndHistories) {
+  std::set<std::int64_t> keys;
+  for (int i = -40; i <= 40; ++i) {
+    for (int j = -40; j <= 40; ++j) keys.insert(CellKey(i, j));
+  }
+  EXPECT_EQ(keys.size(), 81u * 81u);
+  // Keypoints in the four quadrants around the origin land in four histories.
+  StabilityGrid grid(UnitCells());
+  grid.InsertKeypoint(At(-0.5, -0.5, 0, Uniform()));
+  grid.InsertKeypoint(At(-0.5, 0.5, 0, Uniform()));
+  grid.InsertKeypoint(At(0.5, -0.5, 0, Uniform()));
+  grid.InsertKeypoint(At(0.5, 0.5, 0, Uniform()));
+  grid.InsertKeypoint(At(-0.4, -0.6, 1, Uniform()));
+  EXPECT_EQ(grid.Clusters({-1, -1}).front().size(), 2u);
+  EXPECT_EQ(grid.Clusters({-1, 0}).front().size(), 1u);
+  EXPECT_EQ(grid.Clusters({0, -1}).front().size(), 1u);
+  EXPECT_EQ(grid.Clusters({0, 0}).front().size(), 1u);
 }
 
 TEST(MappingConfig, RejectsInvalidFieldsByName) {

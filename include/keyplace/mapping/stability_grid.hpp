@@ -22,6 +22,15 @@ struct CellIndex {
   bool operator==(const CellIndex& other) const { return i == other.i && j == other.j; }
 };
 
+/// Packs a cell (i, j) into one 64-bit key: i in the high and j in the low 32 bits (two's
+/// complement). Computed on unsigned values, so that negative cells are well defined (a left
+/// shift of a negative value is undefined behaviour before C++20).
+constexpr std::int64_t CellKey(int i, int j) {
+  return static_cast<std::int64_t>(
+      (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
+      static_cast<std::uint64_t>(static_cast<std::uint32_t>(j)));
+}
+
 struct CellCounts {
   std::int32_t hits = 0;             // h: beams that ended in the cell
   std::int32_t misses = 0;           // m: beams that crossed the cell without ending in it
@@ -103,9 +112,7 @@ class StabilityGrid {
   CellCounts& At(int i, int j) { return counts_[(j - origin_j_) * width_ + (i - origin_i_)]; }
   void AddMiss(int i, int j, int scan_id);
   void AddHit(int i, int j, int scan_id);
-  static std::int64_t Key(const CellIndex& cell) {
-    return (static_cast<std::int64_t>(cell.i) << 32) ^ static_cast<std::uint32_t>(cell.j);
-  }
+  static std::int64_t Key(const CellIndex& cell) { return CellKey(cell.i, cell.j); }
 
   MappingConfig config_;
   double cell_size_m_;
