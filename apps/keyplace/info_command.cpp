@@ -161,7 +161,7 @@ void PrintMap(const nlohmann::json& json) {
   fmt::print("built from           {} ({}, {} poses, {} scans)\n",
              json["source_log"].get<std::string>(), json["source_hash"].get<std::string>(),
              json["pose_source"].get<std::string>(), json["source_scans"].get<std::size_t>());
-  fmt::print("submaps              {} ({} closed by the scan limit)\n",
+  fmt::print("submaps              {} ({} forced by the scan or grid limit)\n",
              json["submaps"].get<std::size_t>(), json["forced_submaps"].get<std::size_t>());
   fmt::print("stable keypoints     {} of {} ({:.3f}, {:.1f} % less map data)\n",
              json["stable_keypoints"].get<std::size_t>(),

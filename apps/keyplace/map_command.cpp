@@ -81,7 +81,7 @@ void RunMap(const MapOptions& options) {
 
   fmt::print("log                  {} ({} scans, {} poses)\n", options.input, log.scans.size(),
              ToString(source));
-  fmt::print("submaps              {} ({} closed by the scan limit), scans 0..{} of {}\n",
+  fmt::print("submaps              {} ({} forced by the scan or grid limit), scans 0..{} of {}\n",
              stats.submaps, stats.forced_submaps, covered_scans, log.scans.size());
   fmt::print("scans per submap     {:.2f}\n", stats.scans_per_submap);
   fmt::print("keypoints per submap {:.2f}\n", stats.keypoints_per_submap);

@@ -1,17 +1,43 @@
 #include "keyplace/mapping/local_mapper.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 
 namespace keyplace {
 namespace {
 
+// floor(coordinate / cell), saturated to the int range (NaN to its lower end) instead of an
+// undefined conversion. Points of a submap lie far inside it (StabilityGrid::kMaxCellIndex).
+int SaturatedCell(double coordinate_m, double cell_m) {
+  const double cell = std::floor(coordinate_m / cell_m);
+  if (!(cell >= std::numeric_limits<int>::min())) return std::numeric_limits<int>::min();
+  if (!(cell <= std::numeric_limits<int>::max())) return std::numeric_limits<int>::max();
+  return static_cast<int>(cell);
+}
+
 std::int64_t DistributionKey(const Eigen::Vector2d& point_m, double cell_m) {
-  const auto i = static_cast<std::int64_t>(std::floor(point_m.x() / cell_m));
-  const auto j = static_cast<std::int64_t>(std::floor(point_m.y() / cell_m));
-  return CellKey(static_cast<int>(i), static_cast<int>(j));
+  return CellKey(SaturatedCell(point_m.x(), cell_m), SaturatedCell(point_m.y(), cell_m));
+}
+
+bool Finite(const Pose2& pose) {
+  return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.theta);
+}
+
+std::string PoseText(const Pose2& pose) {
+  std::ostringstream text;
+  text << "(" << pose.x << ", " << pose.y << ", " << pose.theta << ")";
+  return text.str();
+}
+
+[[noreturn]] void FailScan(int scan_index, const std::string& what) {
+  throw std::invalid_argument("LocalMapper: scan " + std::to_string(scan_index) + ": " + what);
 }
 
 // delta from the two sets of occupied cells of D; every keypoint cell normally holds laser
@@ -68,25 +94,38 @@ void LocalMapper::Reset() {
   distribution_ = 1.0;
   complete_ = false;
   forced_ = false;
+  grid_limited_ = false;
 }
 
 bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_world_robot,
                           const std::vector<Keypoint>& keypoints) {
+  // Everything is checked before anything changes: on an exception the mapper is as before.
+  if (!Finite(T_world_robot))
+    FailScan(scan_index, "robot pose " + PoseText(T_world_robot) + " is not finite");
+  if (!Finite(scan.T_robot_laser)) {
+    FailScan(scan_index, "laser mounting " + PoseText(scan.T_robot_laser) + " is not finite");
+  }
+  if (scan.valid.size() != scan.size() || scan.angles_rad.size() != scan.size()) {
+    FailScan(scan_index, "ranges, angles and valid flags differ in size");
+  }
   const bool first = poses_.empty();
-  scan_indices_.push_back(scan_index);
-  poses_.push_back(T_world_robot);
-  const Pose2 T_submap_laser = Between(poses_.front(), T_world_robot) * scan.T_robot_laser;
+  const Pose2& T_world_submap = first ? T_world_robot : poses_.front();
+  const Pose2 T_submap_laser = Between(T_world_submap, T_world_robot) * scan.T_robot_laser;
 
-  // UpdateG: counters by ray casting, then the keypoint histories.
   std::vector<Eigen::Vector2d> endpoints_m;
   endpoints_m.reserve(scan.size());
   for (std::size_t i = 0; i < scan.size(); ++i) {
-    if (scan.valid[i] != 0) endpoints_m.push_back(T_submap_laser * scan.Endpoint(i));
+    if (scan.valid[i] == 0) continue;
+    endpoints_m.push_back(T_submap_laser * scan.Endpoint(i));
+    if (!endpoints_m.back().allFinite()) {
+      std::ostringstream what;
+      what << "beam " << i << " (range " << scan.ranges_m[i] << " m, angle " << scan.angles_rad[i]
+           << " rad) has no finite endpoint";
+      FailScan(scan_index, what.str());
+    }
   }
-  grid_.InsertRays(T_submap_laser.translation(), endpoints_m, static_cast<int>(poses_.size()) - 1);
-  laser_points_ += endpoints_m.size();
-  hit_cells_.insert(hit_cells_.end(), grid_.newly_hit_cells().begin(),
-                    grid_.newly_hit_cells().end());
+  std::vector<GridKeypoint> grid_keypoints;
+  grid_keypoints.reserve(keypoints.size());
   for (const Keypoint& keypoint : keypoints) {
     GridKeypoint grid_keypoint;
     grid_keypoint.position_m = T_submap_laser * keypoint.position_m;
@@ -95,14 +134,68 @@ bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_
     grid_keypoint.scale_level = keypoint.scale_level;
     grid_keypoint.scan_index = scan_index;
     grid_keypoint.descriptor = keypoint.descriptor;
-    grid_.InsertKeypoint(grid_keypoint);
+    if (!grid_keypoint.position_m.allFinite() || !std::isfinite(grid_keypoint.orientation_rad)) {
+      FailScan(scan_index, "a keypoint has no finite position or orientation");
+    }
+    grid_keypoints.push_back(grid_keypoint);
   }
+  const std::int64_t cells = CellsNeeded(T_submap_laser.translation(), endpoints_m, grid_keypoints);
+  if (cells > config_.max_grid_cells) {
+    if (first) {
+      double farthest_m = 0.0;
+      for (const auto& endpoint : endpoints_m) {
+        farthest_m = std::max(farthest_m, (endpoint - T_submap_laser.translation()).norm());
+      }
+      std::ostringstream what;
+      what << "alone it would grow the stability grid beyond MappingConfig.max_grid_cells = "
+           << config_.max_grid_cells << " (its farthest beam ends " << farthest_m
+           << " m from the laser); raise max_grid_cells or cell_size_m";
+      FailScan(scan_index, what.str());
+    }
+    // A pose jump: close the submap with the scan's pose but without its data (MappingConfig).
+    scan_indices_.push_back(scan_index);
+    poses_.push_back(T_world_robot);
+    grid_limited_ = true;
+    complete_ = true;
+    forced_ = true;
+    return complete_;
+  }
+  scan_indices_.push_back(scan_index);
+  poses_.push_back(T_world_robot);
+
+  // UpdateG: counters by ray casting, then the keypoint histories.
+  grid_.InsertRays(T_submap_laser.translation(), endpoints_m, static_cast<int>(poses_.size()) - 1);
+  laser_points_ += endpoints_m.size();
+  hit_cells_.insert(hit_cells_.end(), grid_.newly_hit_cells().begin(),
+                    grid_.newly_hit_cells().end());
+  for (const GridKeypoint& grid_keypoint : grid_keypoints) grid_.InsertKeypoint(grid_keypoint);
   if (first) initial_cells_ = OverlapCellCount();
 
   // UpdateS: F is overwritten with the current stable keypoints.
   stable_ = grid_.SelectStable();
   UpdateCompletion();
   return complete_;
+}
+
+std::int64_t LocalMapper::CellsNeeded(const Eigen::Vector2d& origin_m,
+                                      const std::vector<Eigen::Vector2d>& endpoints_m,
+                                      const std::vector<GridKeypoint>& keypoints) const {
+  constexpr std::int64_t kNoCell = std::numeric_limits<std::int64_t>::max();
+  for (const GridKeypoint& keypoint : keypoints) {
+    if (!grid_.TryCellOf(keypoint.position_m)) return kNoCell;
+  }
+  if (endpoints_m.empty()) return grid_.allocated_cell_count();  // InsertRays grows nothing
+  const std::optional<CellIndex> start = grid_.TryCellOf(origin_m);
+  if (!start) return kNoCell;
+  CellIndex min = *start;
+  CellIndex max = *start;
+  for (const auto& endpoint : endpoints_m) {
+    const std::optional<CellIndex> cell = grid_.TryCellOf(endpoint);
+    if (!cell) return kNoCell;
+    min = {std::min(min.i, cell->i), std::min(min.j, cell->j)};
+    max = {std::max(max.i, cell->i), std::max(max.j, cell->j)};
+  }
+  return grid_.CellsToCover(min, max);
 }
 
 std::int64_t LocalMapper::OverlapCellCount() const {
@@ -135,6 +228,10 @@ void LocalMapper::UpdateCompletion() {
   } else {
     distribution_ =
         DistributionFromCells(laser_cells, laser_points_, keypoint_cells, stable_.size());
+  }
+  if (grid_limited_) {  // sticky until Reset
+    complete_ = forced_ = true;
+    return;
   }
   complete_ = overlap_ < config_.min_overlap &&
               (!config_.use_distribution || distribution_ <= config_.max_distribution) &&

@@ -26,6 +26,7 @@ void Validate(const MappingConfig& config) {
   Require(config.distribution_cell_m > 0.0, "distribution_cell_m", "must be positive");
   Require(config.min_stable_keypoints >= 0, "min_stable_keypoints", "must be >= 0");
   Require(config.max_scans_per_submap >= 0, "max_scans_per_submap", "must be >= 0");
+  Require(config.max_grid_cells >= 1, "max_grid_cells", "must be >= 1");
 }
 
 }  // namespace keyplace
@@ -71,7 +72,10 @@ const ConfigFields<MappingConfig>& MappingConfigFields() {
         .Int("min_stable_keypoints", &C::min_stable_keypoints, "",
              "a complete submap holds at least this many stable keypoints")
         .Int("max_scans_per_submap", &C::max_scans_per_submap, "",
-             "close a submap after this many scans anyway (0 = never)");
+             "close a submap after this many scans anyway (0 = never)")
+        .Int("max_grid_cells", &C::max_grid_cells, "",
+             "close a submap before a scan would grow its grid G beyond this many cells "
+             "(20 bytes each)");
     return table;
   }();
   return fields;

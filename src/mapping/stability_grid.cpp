@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "keyplace/features/descriptor.hpp"
 
@@ -10,6 +13,20 @@ namespace keyplace {
 namespace {
 
 constexpr int kGrowthMarginCells = 64;
+
+// floor(coordinate / cell) when it lies within +-kMaxCellIndex (false for NaN and infinities).
+bool CellIndexOf(double coordinate_m, double cell_size_m, int& index) {
+  const double cell = std::floor(coordinate_m / cell_size_m);
+  if (!(std::abs(cell) <= StabilityGrid::kMaxCellIndex)) return false;
+  index = static_cast<int>(cell);
+  return true;
+}
+
+std::string PointText(const Eigen::Vector2d& point_m) {
+  std::ostringstream text;
+  text << "(" << point_m.x() << ", " << point_m.y() << ")";
+  return text.str();
+}
 
 }  // namespace
 
@@ -28,9 +45,23 @@ void StabilityGrid::Clear() {
   history_of_cell_.clear();
 }
 
+std::optional<CellIndex> StabilityGrid::TryCellOf(const Eigen::Vector2d& point_m) const {
+  CellIndex cell;
+  if (!CellIndexOf(point_m.x(), cell_size_m_, cell.i) ||
+      !CellIndexOf(point_m.y(), cell_size_m_, cell.j)) {
+    return std::nullopt;
+  }
+  return cell;
+}
+
 CellIndex StabilityGrid::CellOf(const Eigen::Vector2d& point_m) const {
-  return {static_cast<int>(std::floor(point_m.x() / cell_size_m_)),
-          static_cast<int>(std::floor(point_m.y() / cell_size_m_))};
+  const std::optional<CellIndex> cell = TryCellOf(point_m);
+  if (!cell) {
+    throw std::invalid_argument("StabilityGrid: point " + PointText(point_m) +
+                                " m has no cell (not finite, or beyond " +
+                                std::to_string(kMaxCellIndex) + " cells from the origin)");
+  }
+  return *cell;
 }
 
 Eigen::Vector2d StabilityGrid::CellCenter(const CellIndex& cell) const {
@@ -38,18 +69,31 @@ Eigen::Vector2d StabilityGrid::CellCenter(const CellIndex& cell) const {
 }
 
 CellCounts StabilityGrid::Counts(const CellIndex& cell) const {
-  if (cell.i < origin_i_ || cell.j < origin_j_ || cell.i >= origin_i_ + width_ ||
-      cell.j >= origin_j_ + height_) {
-    return {};
+  if (!Allocated(cell.i, cell.j)) return {};
+  return counts_[static_cast<std::size_t>(cell.j - origin_j_) * static_cast<std::size_t>(width_) +
+                 static_cast<std::size_t>(cell.i - origin_i_)];
+}
+
+std::int64_t StabilityGrid::CellsToCover(const CellIndex& min, const CellIndex& max) const {
+  if (width_ > 0 && Allocated(min.i, min.j) && Allocated(max.i, max.j)) {
+    return allocated_cell_count();
   }
-  return counts_[(cell.j - origin_j_) * width_ + (cell.i - origin_i_)];
+  // As EnsureCovers, in 64 bits (indices lie within +-kMaxCellIndex, so nothing overflows).
+  std::int64_t new_min_i = std::int64_t{min.i} - kGrowthMarginCells;
+  std::int64_t new_min_j = std::int64_t{min.j} - kGrowthMarginCells;
+  std::int64_t new_max_i = std::int64_t{max.i} + kGrowthMarginCells;
+  std::int64_t new_max_j = std::int64_t{max.j} + kGrowthMarginCells;
+  if (width_ > 0) {
+    new_min_i = std::min<std::int64_t>(new_min_i, origin_i_);
+    new_min_j = std::min<std::int64_t>(new_min_j, origin_j_);
+    new_max_i = std::max<std::int64_t>(new_max_i, std::int64_t{origin_i_} + width_ - 1);
+    new_max_j = std::max<std::int64_t>(new_max_j, std::int64_t{origin_j_} + height_ - 1);
+  }
+  return (new_max_i - new_min_i + 1) * (new_max_j - new_min_j + 1);
 }
 
 void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
-  if (width_ > 0 && min_i >= origin_i_ && min_j >= origin_j_ && max_i < origin_i_ + width_ &&
-      max_j < origin_j_ + height_) {
-    return;
-  }
+  if (width_ > 0 && Allocated(min_i, min_j) && Allocated(max_i, max_j)) return;
   int new_min_i = min_i - kGrowthMarginCells;
   int new_min_j = min_j - kGrowthMarginCells;
   int new_max_i = max_i + kGrowthMarginCells;
@@ -77,6 +121,8 @@ void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
 }
 
 void StabilityGrid::AddMiss(int i, int j, int scan_id) {
+  // Rounding can step the traversal one cell past the endpoint's; never outside the counters.
+  if (!Allocated(i, j)) return;
   CellCounts& cell = At(i, j);
   if (config_.density_counting == MappingConfig::DensityCounting::kScans) {
     // Once per scan, and not at all when this scan also ends a beam in the cell (the hits of a
@@ -116,6 +162,13 @@ void StabilityGrid::InsertRays(const Eigen::Vector2d& origin_m,
     max_i = std::max(max_i, cell.i);
     min_j = std::min(min_j, cell.j);
     max_j = std::max(max_j, cell.j);
+  }
+  const std::int64_t cells = CellsToCover({min_i, min_j}, {max_i, max_j});
+  if (cells > config_.max_grid_cells) {
+    throw std::invalid_argument("StabilityGrid: scan " + std::to_string(scan_id) +
+                                " would grow the grid to " + std::to_string(cells) +
+                                " cells, more than MappingConfig.max_grid_cells = " +
+                                std::to_string(config_.max_grid_cells));
   }
   EnsureCovers(min_i, min_j, max_i, max_j);
 

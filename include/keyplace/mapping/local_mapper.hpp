@@ -30,6 +30,11 @@ class LocalMapper {
 
   /// Adds the next scan: its laser data, the robot pose T_world_robot and its keypoints (laser
   /// frame). Runs UpdateG and UpdateS; returns true when the submap is complete after this scan.
+  /// A scan whose beams would grow G beyond MappingConfig::max_grid_cells (a pose jump) completes
+  /// the submap (forced, grid_limited()) with its pose but without its beams and keypoints.
+  /// Throws std::invalid_argument naming the scan, leaving the mapper unchanged, when the pose,
+  /// the laser mounting, a valid beam's endpoint or a keypoint is not finite, or when the scan
+  /// alone, as the first of a submap, needs more than max_grid_cells.
   bool AddScan(int scan_index, const LaserScan& scan, const Pose2& T_world_robot,
                const std::vector<Keypoint>& keypoints);
 
@@ -42,11 +47,17 @@ class LocalMapper {
   double distribution() const { return distribution_; }
   bool complete() const { return complete_; }
   bool forced() const { return forced_; }
+  /// The submap was closed because a scan did not fit in max_grid_cells (then also forced()).
+  bool grid_limited() const { return grid_limited_; }
   const StabilityGrid& grid() const { return grid_; }
 
  private:
   void UpdateCompletion();
   std::int64_t OverlapCellCount() const;
+  // Cells G would hold after inserting these (submap frame); int64 max when a point has no cell.
+  std::int64_t CellsNeeded(const Eigen::Vector2d& origin_m,
+                           const std::vector<Eigen::Vector2d>& endpoints_m,
+                           const std::vector<GridKeypoint>& keypoints) const;
 
   MappingConfig config_;
   StabilityGrid grid_;
@@ -60,6 +71,7 @@ class LocalMapper {
   double distribution_ = 1.0;
   bool complete_ = false;
   bool forced_ = false;
+  bool grid_limited_ = false;
 };
 
 }  // namespace keyplace

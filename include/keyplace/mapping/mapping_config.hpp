@@ -1,6 +1,8 @@
 #pragma once
 // Parameters of stable-keypoint mapping (paper Section 3, defaults from Table V and Section 5.2).
 
+#include <cstdint>
+
 namespace keyplace {
 
 struct MappingConfig {
@@ -48,6 +50,13 @@ struct MappingConfig {
   // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
   // submap that cannot be completed, as in the paper).
   int max_scans_per_submap = 300;
+  // Safety net absent from the paper, bounding memory: the dense counters of G span the bounding
+  // box of the submap's beams (plus a margin), sizeof(CellCounts) = 20 bytes per cell. A scan
+  // that would grow them beyond this many cells (a pose jump: an odometry glitch) closes the
+  // submap instead: its pose is kept, its beams and keypoints are not inserted, and the submap
+  // is flagged `forced`. A single scan that needs more on its own is an error. See
+  // docs/MAPPING.md. The default, 2^24 cells (320 MiB), holds 400 m x 400 m at l_g = 0.1 m.
+  std::int64_t max_grid_cells = std::int64_t{1} << 24;
 };
 
 /// Throws std::invalid_argument naming the first invalid field.

@@ -5,6 +5,7 @@
 // descriptors sorted by decreasing size. Everything is in the submap frame.
 
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -57,7 +58,9 @@ class StabilityGrid {
 
   /// UpdateG's counters: ray-casts each endpoint from `origin_m` (both in the submap frame). The
   /// endpoint's cell gets a hit, every other cell the ray crosses a miss (counted per beam or
-  /// once per scan, MappingConfig::density_counting). `scan_id` must grow.
+  /// once per scan, MappingConfig::density_counting). `scan_id` must grow. Throws
+  /// std::invalid_argument, leaving the grid unchanged, when a point has no cell (CellOf) or
+  /// the counters would grow beyond MappingConfig::max_grid_cells (CellsToCover).
   void InsertRays(const Eigen::Vector2d& origin_m, const std::vector<Eigen::Vector2d>& endpoints_m,
                   int scan_id);
 
@@ -65,8 +68,25 @@ class StabilityGrid {
   /// first), or into a new cluster; keeps clusters sorted by decreasing size (stable).
   void InsertKeypoint(const GridKeypoint& keypoint);
 
+  /// Cells are indexed within +-kMaxCellIndex along each axis (about 54 000 km at 0.1 m cells),
+  /// so that no index or grid size computation can overflow.
+  static constexpr int kMaxCellIndex = 1 << 29;
+
+  /// The cell of a point; nullopt when a coordinate is not finite or its cell index lies beyond
+  /// +-kMaxCellIndex.
+  std::optional<CellIndex> TryCellOf(const Eigen::Vector2d& point_m) const;
+  /// TryCellOf, or std::invalid_argument naming the point when it has no cell.
   CellIndex CellOf(const Eigen::Vector2d& point_m) const;
   Eigen::Vector2d CellCenter(const CellIndex& cell) const;
+
+  /// Cells the dense counters would hold once grown to cover every cell from `min` to `max`
+  /// (inclusive), as InsertRays grows them (with a margin). The current count when they already
+  /// cover it.
+  std::int64_t CellsToCover(const CellIndex& min, const CellIndex& max) const;
+  /// Cells the dense counters hold now (each sizeof(CellCounts) bytes).
+  std::int64_t allocated_cell_count() const {
+    return static_cast<std::int64_t>(width_) * static_cast<std::int64_t>(height_);
+  }
   /// Counters of a cell (all zero outside the grown area).
   CellCounts Counts(const CellIndex& cell) const;
 
@@ -109,7 +129,13 @@ class StabilityGrid {
   };
 
   void EnsureCovers(int min_i, int min_j, int max_i, int max_j);
-  CellCounts& At(int i, int j) { return counts_[(j - origin_j_) * width_ + (i - origin_i_)]; }
+  bool Allocated(int i, int j) const {
+    return i >= origin_i_ && j >= origin_j_ && i < origin_i_ + width_ && j < origin_j_ + height_;
+  }
+  CellCounts& At(int i, int j) {
+    return counts_[static_cast<std::size_t>(j - origin_j_) * static_cast<std::size_t>(width_) +
+                   static_cast<std::size_t>(i - origin_i_)];
+  }
   void AddMiss(int i, int j, int scan_id);
   void AddHit(int i, int j, int scan_id);
   static std::int64_t Key(const CellIndex& cell) { return CellKey(cell.i, cell.j); }
