@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -70,8 +71,8 @@ void Tokenize(std::string_view line, std::vector<std::string_view>& tokens) {
 class FieldParser {
  public:
   FieldParser(const std::string& path, std::size_t line,
-              const std::vector<std::string_view>& tokens)
-      : path_(path), line_(line), tokens_(tokens) {}
+              const std::vector<std::string_view>& tokens, double max_coordinate_m)
+      : path_(path), line_(line), tokens_(tokens), max_coordinate_m_(max_coordinate_m) {}
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw std::invalid_argument(path_ + ":" + std::to_string(line_) + ": " +
@@ -96,6 +97,25 @@ class FieldParser {
   double Number(std::size_t index, const std::string& field) const {
     const double value = AnyNumber(index, field);
     if (!std::isfinite(value)) Fail("field '" + field + "' is not finite: '" + Token(index) + "'");
+    return value;
+  }
+
+  // A position coordinate (m): finite and within +-max_coordinate_m.
+  double Coordinate(std::size_t index, const std::string& field) const {
+    const double value = Number(index, field);
+    if (!(std::abs(value) <= max_coordinate_m_)) {
+      Fail("field '" + field + "' = " + Token(index) + " m lies beyond +-" +
+           FormatNumber(max_coordinate_m_) + " m (CarmenReadOptions::max_coordinate_m)");
+    }
+    return value;
+  }
+
+  // An angle (rad): finite and within +-2 pi.
+  double Angle(std::size_t index, const std::string& field) const {
+    const double value = Number(index, field);
+    if (!(std::abs(value) <= 2.0 * M_PI)) {
+      Fail("field '" + field + "' = " + Token(index) + " rad is not an angle in [-2 pi, 2 pi]");
+    }
     return value;
   }
 
@@ -138,9 +158,16 @@ class FieldParser {
   std::size_t size() const { return tokens_.size(); }
 
  private:
+  static std::string FormatNumber(double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%g", value);
+    return text;
+  }
+
   const std::string& path_;
   std::size_t line_;
   const std::vector<std::string_view>& tokens_;
+  double max_coordinate_m_;
 };
 
 constexpr long kMaxBeams = 100000;
@@ -164,6 +191,24 @@ void ClassifyBeams(LaserScan& scan, CarmenLog& log) {
     } else {
       scan.valid[i] = 1;
     }
+  }
+}
+
+// The PARAMs that give FLASER/RLASER lines their angles (ParamDegrees): a number there must be
+// a finite angle in (0, 360] degrees (an infinite field of view made every beam angle NaN). A
+// value that is no number, zero or negative keeps being ignored (the defaults apply).
+void CheckLaserGeometryParam(const FieldParser& fields) {
+  const std::string name = fields.Token(1);
+  if (name != "laser_front_laser_fov" && name != "laser_front_laser_resolution" &&
+      name != "laser_rear_laser_fov" && name != "laser_rear_laser_resolution") {
+    return;
+  }
+  const std::string token = fields.Token(2);
+  double value = 0.0;
+  const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (result.ec != std::errc() || !(value > 0.0)) return;
+  if (!(value <= 360.0)) {
+    fields.Fail(name + " = '" + token + "' is not an angle in (0, 360] degrees");
   }
 }
 
@@ -203,9 +248,9 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
     scan.angles_rad[i] = -0.5 * fov_rad + static_cast<double>(i) * step_rad;
   }
   const std::size_t p = 2 + n;
-  const Pose2 laser(fields.Number(p, "laser x"), fields.Number(p + 1, "laser y"),
+  const Pose2 laser(fields.Coordinate(p, "laser x"), fields.Coordinate(p + 1, "laser y"),
                     fields.Number(p + 2, "laser theta"));
-  const Pose2 robot(fields.Number(p + 3, "robot x"), fields.Number(p + 4, "robot y"),
+  const Pose2 robot(fields.Coordinate(p + 3, "robot x"), fields.Coordinate(p + 4, "robot y"),
                     fields.Number(p + 5, "robot theta"));
   scan.odometry_pose = robot;  // moved to corrected_pose at the end for corrected logs
   scan.T_robot_laser = Between(robot, laser);
@@ -222,8 +267,9 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
   fields.ExpectAtLeast(9,
                        "name type start_angle fov resolution max_range accuracy "
                        "remission_mode n ...");
-  const double start_rad = fields.Number(2, "start_angle");
-  const double resolution_rad = fields.Number(4, "angular_resolution");
+  const double start_rad = fields.Angle(2, "start_angle");
+  fields.Angle(3, "fov");  // not used (the beams are start + i * resolution), but checked
+  const double resolution_rad = fields.Angle(4, "angular_resolution");
   const double max_range_m = fields.Number(5, "max_range");
   const std::size_t n = fields.Count(8, "n (beam count)", kMaxBeams);
   fields.ExpectAtLeast(10 + n, "9 header fields, " + std::to_string(n) + " ranges, m ...");
@@ -244,9 +290,9 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
     scan.angles_rad[i] = start_rad + static_cast<double>(i) * resolution_rad;
   }
   const std::size_t p = 10 + n + m;
-  const Pose2 laser(fields.Number(p, "laser x"), fields.Number(p + 1, "laser y"),
+  const Pose2 laser(fields.Coordinate(p, "laser x"), fields.Coordinate(p + 1, "laser y"),
                     fields.Number(p + 2, "laser theta"));
-  const Pose2 robot(fields.Number(p + 3, "robot x"), fields.Number(p + 4, "robot y"),
+  const Pose2 robot(fields.Coordinate(p + 3, "robot x"), fields.Coordinate(p + 4, "robot y"),
                     fields.Number(p + 5, "robot theta"));
   scan.odometry_pose = robot;
   scan.T_robot_laser = Between(robot, laser);
@@ -269,7 +315,7 @@ void ParseLine(const std::string& path, std::size_t line_number,
     if (text.find("SEQUENTIAL EDGES") != std::string::npos) state.in_loop_edges = false;
     return;
   }
-  const FieldParser fields(path, line_number, tokens);
+  const FieldParser fields(path, line_number, tokens, state.options.max_coordinate_m);
   if (type == "FLASER") {
     log.scans.push_back(ParseFlaser(fields, line_number, state, true));
   } else if (type == "RLASER") {
@@ -279,7 +325,8 @@ void ParseLine(const std::string& path, std::size_t line_number,
   } else if (type == "ODOM") {
     fields.ExpectFieldCount(10, "ODOM x y theta tv rv accel ipc_timestamp host logger_timestamp");
     OdometryMessage odom;
-    odom.pose = Pose2(fields.Number(1, "x"), fields.Number(2, "y"), fields.Number(3, "theta"));
+    odom.pose =
+        Pose2(fields.Coordinate(1, "x"), fields.Coordinate(2, "y"), fields.Number(3, "theta"));
     odom.tv_mps = fields.Number(4, "tv");
     odom.rv_radps = fields.Number(5, "rv");
     odom.timestamp_s = fields.Number(7, "ipc_timestamp");
@@ -287,12 +334,14 @@ void ParseLine(const std::string& path, std::size_t line_number,
     log.odometry.push_back(odom);
   } else if (type == "PARAM") {
     fields.ExpectAtLeast(3, "PARAM name value ...");
+    CheckLaserGeometryParam(fields);
     log.params[fields.Token(1)] = fields.Token(2);
   } else if (type == "VERTEX2") {
     fields.ExpectFieldCount(5, "VERTEX2 id x y theta");
     GraphVertex vertex;
     vertex.id = fields.Integer(1, "id");
-    vertex.pose = Pose2(fields.Number(2, "x"), fields.Number(3, "y"), fields.Number(4, "theta"));
+    vertex.pose =
+        Pose2(fields.Coordinate(2, "x"), fields.Coordinate(3, "y"), fields.Number(4, "theta"));
     log.vertices.push_back(vertex);
     state.saw_corrected_marker = true;
   } else if (type == "EDGE2") {
@@ -301,7 +350,7 @@ void ParseLine(const std::string& path, std::size_t line_number,
     edge.from = fields.Integer(1, "from");
     edge.to = fields.Integer(2, "to");
     edge.T_from_to =
-        Pose2(fields.Number(3, "dx"), fields.Number(4, "dy"), fields.Number(5, "dtheta"));
+        Pose2(fields.Coordinate(3, "dx"), fields.Coordinate(4, "dy"), fields.Number(5, "dtheta"));
     static const char* const kInfoNames[6] = {"I_xx", "I_xy", "I_yy", "I_tt", "I_xt", "I_yt"};
     for (int k = 0; k < 6; ++k) edge.information[k] = fields.Number(6 + k, kInfoNames[k]);
     edge.loop = state.in_loop_edges;
@@ -320,6 +369,9 @@ void ParseLine(const std::string& path, std::size_t line_number,
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
   if (!(options.flaser_max_range_m > 0.0)) {
     throw std::invalid_argument("CarmenReadOptions.flaser_max_range_m must be positive");
+  }
+  if (!(options.max_coordinate_m > 0.0)) {
+    throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
   }
   ReaderState state;
   state.options = options;

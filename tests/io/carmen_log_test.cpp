@@ -15,7 +15,7 @@ namespace keyplace {
 namespace {
 
 std::string WriteText(const std::string& name, const std::string& text) {
-  const std::string path = testing::MakeTempDir("carmen") + "/" + name;
+  std::string path = testing::MakeTempDir("carmen") + "/" + name;
   std::ofstream(path) << text;
   return path;
 }
@@ -161,6 +161,60 @@ TEST(CarmenLog, NonNumericFieldIsNamed) {
   ExpectError<std::invalid_argument>(odom, {odom + ":1", "ODOM", "expected 10 fields"});
   const std::string count = WriteText("count.log", "FLASER -3 1 2\n");
   ExpectError<std::invalid_argument>(count, {count + ":1", "beam count"});
+}
+
+TEST(CarmenLog, NonFiniteOrAbsurdFieldOfViewIsAnErrorNamingTheLine) {
+  // Formerly an infinite field of view was taken and made every beam angle NaN.
+  for (const std::string value : {"inf", "1e300", "720"}) {
+    const std::string path = WriteText("fov_" + value + ".log",
+                                       "# c\nPARAM laser_front_laser_fov " + value + " nohost 0\n" +
+                                           Flaser(10, "1.0", "0 0 0 0 0 0 1 h 1"));
+    ExpectError<std::invalid_argument>(path, {path + ":2", "laser_front_laser_fov", value});
+  }
+  const std::string resolution =
+      WriteText("resolution.log", "PARAM laser_front_laser_resolution inf nohost 0\n" +
+                                      Flaser(4, "1", "0 0 0 0 0 0 1 h 1"));
+  ExpectError<std::invalid_argument>(resolution, {resolution + ":1", "resolution"});
+  // A value that is no angle at all is still ignored (180 degrees), as before.
+  const std::string ignored =
+      WriteText("ignored.log", "PARAM laser_front_laser_fov none nohost 0\n" +
+                                   Flaser(4, "1", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog log = ReadCarmenLog(ignored);
+  ASSERT_EQ(log.scans.size(), 1u);
+  EXPECT_DOUBLE_EQ(log.scans[0].angles_rad[0], -M_PI / 2.0);
+  // ROBOTLASER1 carries its own geometry: fov and angular resolution must be finite angles.
+  const std::string robot_laser =
+      "ROBOTLASER1 0 -1.570796 FOV RES 50.0 0.1 0 2 1 2 0 "
+      "0 0 0 0 0 0 0 0 0 0 0 10.5 x 0.0\n";
+  const auto with = [&](const std::string& fov, const std::string& res) {
+    std::string line = robot_laser;
+    line.replace(line.find("FOV"), 3, fov);
+    line.replace(line.find("RES"), 3, res);
+    return line;
+  };
+  const std::string fov_inf = WriteText("rl_fov.log", with("inf", "0.01"));
+  ExpectError<std::invalid_argument>(fov_inf, {fov_inf + ":1", "'fov'"});
+  const std::string res_huge = WriteText("rl_res.log", with("3.14", "1e300"));
+  ExpectError<std::invalid_argument>(res_huge, {res_huge + ":1", "'angular_resolution'"});
+  EXPECT_EQ(ReadCarmenLog(WriteText("rl_ok.log", with("3.14", "0.01"))).scans.size(), 1u);
+}
+
+TEST(CarmenLog, FarCoordinatesAreAnErrorNamingLineAndField) {
+  // A pose 3e8 m away is a corrupt line (formerly it crashed keyplace map).
+  const std::string far =
+      WriteText("far.log", "# c\n# d\n" + Flaser(2, "1", "0 0 0 3e8 0 0 1 h 1"));
+  ExpectError<std::invalid_argument>(far, {far + ":3", "'robot x'", "max_coordinate_m"});
+  const std::string odom = WriteText("far_odom.log", "ODOM 1 -1e300 0 0 0 0 7 h 8\n");
+  ExpectError<std::invalid_argument>(odom, {odom + ":1", "ODOM", "'y'"});
+  const std::string vertex = WriteText("far_vertex.log", "VERTEX2 0 2e7 0 0\n");
+  ExpectError<std::invalid_argument>(vertex, {vertex + ":1", "VERTEX2", "'x'"});
+  // UTM-sized coordinates are fine; the bound is an option.
+  const std::string utm =
+      WriteText("utm.log", Flaser(2, "1", "412000 5318000 0 412000 5318000 0 1 h 1"));
+  EXPECT_EQ(ReadCarmenLog(utm).scans.size(), 1u);
+  CarmenReadOptions tight;
+  tight.max_coordinate_m = 1e5;
+  EXPECT_THROW(ReadCarmenLog(utm, tight), std::invalid_argument);
 }
 
 TEST(CarmenLog, TruncatedGzipIsAnError) {

@@ -69,6 +69,10 @@ struct CarmenReadOptions {
   // "no return" threshold for FLASER/RLASER lines, which carry no max range of their own (m).
   // ROBOTLASER1 lines use their own max_range field. Ranges >= this are invalid.
   double flaser_max_range_m = 80.0;
+  // Positions (x, y of laser, robot, ODOM and VERTEX2 poses, EDGE2 dx, dy) beyond +-this are
+  // errors: such a pose is a corrupt line, not a place. 1e7 m keeps UTM (northing < 1e7 m) and
+  // earth-centred coordinates; a double still resolves 2 nm there.
+  double max_coordinate_m = 1e7;
   // Overrides the decision taken from the file content (VERTEX2 / NEFF lines) when set.
   enum class PoseKind { kAuto, kCorrected, kOdometry } pose_kind = PoseKind::kAuto;
 };
