@@ -266,6 +266,11 @@ void PrimRound(int n, CurvatureWorkspace& ws) {
 // label-correcting (FIFO queue): the graph is nearly a chain and the queue order nearly follows
 // the distance, so few vertices are visited twice and no heap is needed. The labels are the
 // shortest-path lengths (equal to Dijkstra's up to the rounding of the sums).
+//
+// d(s, v) of a cut edge is looked up in row v, which keeps for that purpose its distances to the
+// vertices t <= reach(v) (the highest neighbour of v: no cut edge from v goes further), sorted
+// by t and read with a cursor that only moves forward as s grows. Memory is linear in n plus the
+// pairs within the radius (a dense n x n table took 8 n^2 bytes: 3.2 GB for 20 000 beams).
 void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWorkspace& ws) {
   const int num_scales = static_cast<int>(radii.size());
   const double max_radius = radii.back();
@@ -279,16 +284,34 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
   ws.queue.resize(static_cast<std::size_t>(n) + 1);
   ws.touched.resize(n);
   ws.touched_band.resize(n);
-  // dist_ahead[v * n + j] = d(v, j) for j > v within the radius, +inf otherwise.
-  ws.dist_ahead.assign(static_cast<std::size_t>(n) * n, kInf);
+  const int* adj_offsets = ws.adj_offsets.data();
+  const AdjacentVertex* adjacent = ws.adjacent.data();
+  // reach[v]: the highest neighbour of v (v when none is higher).
+  ws.reach.resize(n);
+  for (int v = 0; v < n; ++v) {
+    int reach = v;
+    for (int e = adj_offsets[v]; e < adj_offsets[v + 1]; ++e) {
+      reach = std::max(reach, adjacent[e].vertex);
+    }
+    ws.reach[v] = reach;
+  }
+  // Row v's d(v, t) for v < t <= reach[v] within the radius, sorted by t, from ahead_offsets[v].
+  ws.ahead_offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  ws.ahead_cursor.resize(n);
+  ws.ahead.clear();
   GeodesicLabel* label = ws.labels.data();
   int* queue = ws.queue.data();  // ring buffer of capacity n + 1
   int* touched = ws.touched.data();
   int* touched_band = ws.touched_band.data();
-  double* dist_ahead = ws.dist_ahead.data();
   const int capacity = n + 1;
-  const int* adj_offsets = ws.adj_offsets.data();
-  const AdjacentVertex* adjacent = ws.adjacent.data();
+  // d(v, s) from row v (v < s; s never decreases between calls for the same v), +inf when s lies
+  // beyond the radius from v.
+  const auto distance_ahead = [&ws](int v, int s) {
+    const int end = ws.ahead_offsets[v + 1];
+    int& cursor = ws.ahead_cursor[v];
+    while (cursor < end && ws.ahead[cursor].vertex < s) ++cursor;
+    return cursor < end && ws.ahead[cursor].vertex == s ? ws.ahead[cursor].weight : kInf;
+  };
   int band_start[kMaxScales];
   // Edges (v, t) with v < s <= t for the current s, as (v, index into adjacent).
   std::vector<std::pair<int, int>>& crossing = ws.crossing_edges;
@@ -314,7 +337,7 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
     }
     // Seeds through the vertices below source.
     for (const auto& [v, e] : crossing) {
-      const double d = dist_ahead[static_cast<std::size_t>(v) * n + source] + adjacent[e].weight;
+      const double d = distance_ahead(v, source) + adjacent[e].weight;
       if (!(d <= max_radius)) continue;
       const int t = adjacent[e].vertex;
       GeodesicLabel& target = label[t];
@@ -353,11 +376,11 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
     }
     // Row: the vertices j > source, grouped by scale band (counting sort).
     int band_count[kMaxScales] = {};
-    double* ahead = dist_ahead + static_cast<std::size_t>(source) * n;
+    const std::size_t ahead_begin = ws.ahead.size();
     for (int k = 1; k < num_touched; ++k) {  // touched[0] is the source
       const int t = touched[k];
       const double d = label[t].dist;
-      ahead[t] = d;
+      if (t <= ws.reach[source]) ws.ahead.push_back(AdjacentVertex{d, t});
       const double d2 = d * d;
       int band = 0;
       while (d2 > radii2[band]) ++band;  // d <= max_radius, so band < num_scales
@@ -382,6 +405,10 @@ void TruncatedGeodesicRows(int n, const std::vector<double>& radii, CurvatureWor
       row_dist2[slot] = label[t].dist * label[t].dist;
     }
     ws.row_offsets[source + 1] = static_cast<int>(ws.row_vertex.size());
+    std::sort(ws.ahead.begin() + static_cast<std::ptrdiff_t>(ahead_begin), ws.ahead.end(),
+              [](const AdjacentVertex& a, const AdjacentVertex& b) { return a.vertex < b.vertex; });
+    ws.ahead_offsets[source + 1] = static_cast<int>(ws.ahead.size());
+    ws.ahead_cursor[source] = ws.ahead_offsets[source];
   }
 }
 

@@ -148,7 +148,9 @@ struct CurvatureWorkspace {
   std::vector<double> row_dist2;
   std::vector<GeodesicLabel> labels;
   std::vector<int> queue, touched, touched_band;
-  std::vector<double> dist_ahead;
+  // Each row's distances to its vertices up to its highest neighbour (TruncatedGeodesicRows).
+  std::vector<int> reach, ahead_offsets, ahead_cursor;
+  std::vector<AdjacentVertex> ahead;  // (distance, vertex)
   std::vector<std::pair<int, int>> crossing_edges;
   // Smoothing.
   std::vector<double> kernel, density, inv_density, sum_w, sum_wx, sum_wy;

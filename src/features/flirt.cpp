@@ -48,6 +48,11 @@ void CheckScan(const LaserScan& scan) {
         "LaserScan.angles_rad has " + std::to_string(scan.angles_rad.size()) +
         " entries but ranges_m has " + std::to_string(scan.ranges_m.size()));
   }
+  if (scan.ranges_m.size() > kMaxScanBeams) {
+    throw std::invalid_argument("LaserScan has " + std::to_string(scan.ranges_m.size()) +
+                                " beams, more than the " + std::to_string(kMaxScanBeams) +
+                                " FLIRT takes (kMaxScanBeams): downsample the scan");
+  }
 }
 
 bool BeamValid(const LaserScan& scan, std::size_t i) {

@@ -145,11 +145,15 @@ class FieldParser {
     return value;
   }
 
-  std::size_t Count(std::size_t index, const std::string& field, long max_count) const {
+  // A beam (or remission) count: at most kMaxScanBeams.
+  std::size_t BeamCount(std::size_t index, const std::string& field) const {
     const long value = Integer(index, field);
-    if (value < 0 || value > max_count) {
-      Fail("field '" + field + "' = " + std::to_string(value) + " is out of range [0, " +
-           std::to_string(max_count) + "]");
+    if (value < 0) Fail("field '" + field + "' = " + std::to_string(value) + " is negative");
+    if (static_cast<unsigned long>(value) > kMaxScanBeams) {
+      Fail("field '" + field + "' = " + std::to_string(value) + " is above " +
+           std::to_string(kMaxScanBeams) +
+           ", the most beams per scan keyplace takes (real 2D lidars give at most about 4000; "
+           "downsample the scan)");
     }
     return static_cast<std::size_t>(value);
   }
@@ -169,8 +173,6 @@ class FieldParser {
   const std::vector<std::string_view>& tokens_;
   double max_coordinate_m_;
 };
-
-constexpr long kMaxBeams = 100000;
 
 struct ReaderState {
   CarmenLog log;
@@ -224,7 +226,7 @@ double ParamDegrees(const CarmenLog& log, const std::string& name, double fallba
 // FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
 LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& state, bool front) {
   fields.ExpectAtLeast(2, "name n ...");
-  const std::size_t n = fields.Count(1, "n (beam count)", kMaxBeams);
+  const std::size_t n = fields.BeamCount(1, "n (beam count)");
   const std::string layout = "name n, " + std::to_string(n) +
                              " ranges, laser x y theta, robot x y theta, ipc_timestamp, host, "
                              "logger_timestamp";
@@ -271,9 +273,9 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
   fields.Angle(3, "fov");  // not used (the beams are start + i * resolution), but checked
   const double resolution_rad = fields.Angle(4, "angular_resolution");
   const double max_range_m = fields.Number(5, "max_range");
-  const std::size_t n = fields.Count(8, "n (beam count)", kMaxBeams);
+  const std::size_t n = fields.BeamCount(8, "n (beam count)");
   fields.ExpectAtLeast(10 + n, "9 header fields, " + std::to_string(n) + " ranges, m ...");
-  const std::size_t m = fields.Count(9 + n, "m (remission count)", kMaxBeams);
+  const std::size_t m = fields.BeamCount(9 + n, "m (remission count)");
   fields.ExpectFieldCount(n + m + 24, "9 header fields, " + std::to_string(n) + " ranges, m, " +
                                           std::to_string(m) +
                                           " remissions, laser pose, robot pose, tv rv "

@@ -217,6 +217,18 @@ TEST(CarmenLog, FarCoordinatesAreAnErrorNamingLineAndField) {
   EXPECT_THROW(ReadCarmenLog(utm, tight), std::invalid_argument);
 }
 
+TEST(CarmenLog, MoreBeamsThanRealLidarsGiveIsAnErrorNamingTheLine) {
+  // Formerly 100 000 beams per scan were read, and FLIRT then asked for n^2 doubles.
+  const std::size_t too_many = kMaxScanBeams + 1;
+  const std::string path = WriteText(
+      "beams.log", "# c\n" + Flaser(static_cast<int>(too_many), "1", "0 0 0 0 0 0 1 h 1"));
+  ExpectError<std::invalid_argument>(
+      path, {path + ":2", "beam count", std::to_string(too_many), std::to_string(kMaxScanBeams)});
+  const std::string most =
+      WriteText("most.log", Flaser(static_cast<int>(kMaxScanBeams), "1", "0 0 0 0 0 0 1 h 1"));
+  EXPECT_EQ(ReadCarmenLog(most).scans.at(0).size(), kMaxScanBeams);
+}
+
 TEST(CarmenLog, TruncatedGzipIsAnError) {
   const std::string dir = testing::MakeTempDir("carmen-gz");
   const std::string path = dir + "/truncated.log.gz";

@@ -63,7 +63,9 @@ struct FlirtSignals {
 
 /// FLIRT detector + beta-grid descriptor. Immutable after construction; all methods are const
 /// and thread-safe: scratch buffers live in a per-thread workspace that is reused between calls
-/// (about 8 n^2 bytes for n valid beams, e.g. 1 MB for 360 beams).
+/// (about 100 bytes per valid beam plus 20 per pair of valid beams within the kernel cutoff of
+/// the largest scale: 4 MiB for 360 beams, 57 MiB for 8192 beams in a 40 m room, 650 MiB when
+/// all 8192 lie within the cutoff of each other).
 class FlirtExtractor {
  public:
   explicit FlirtExtractor(FlirtConfig config = {});
@@ -81,7 +83,7 @@ class FlirtExtractor {
   /// FLIRTLib's output exactly.
   /// A beam is used when its range is finite, >= 0 and < scan.max_range_m. Scans with fewer than
   /// 5 such beams give no keypoints. Throws std::invalid_argument when ranges_m and angles_rad
-  /// differ in size.
+  /// differ in size or the scan has more than kMaxScanBeams beams.
   std::vector<Keypoint> Extract(const LaserScan& scan, const Pose2& T_world_laser = Pose2()) const;
 
   /// Extract without the descriptors (they stay zero).

@@ -12,6 +12,11 @@
 
 namespace keyplace {
 
+/// Most beams per scan the library takes (the CARMEN reader, FLIRT): twice the ~4000 of the
+/// densest common 2D lidars. FLIRT's memory grows with the pairs of beams within its kernel
+/// cutoff; at this count it stays below about 650 MiB per thread (docs/RELIABILITY.md).
+constexpr std::size_t kMaxScanBeams = 8192;
+
 struct LaserScan {
   std::vector<double> ranges_m;    // one per beam, as written in the log
   std::vector<double> angles_rad;  // beam bearing in the laser frame, same length as ranges_m
