@@ -17,6 +17,11 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+void PrintLogWarnings(const CarmenLog& log) {
+  for (const std::string& warning : log.warnings)
+    fmt::print(stderr, "keyplace: warning: {}\n", warning);
+}
+
 void WriteJson(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }

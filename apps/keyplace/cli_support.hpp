@@ -13,7 +13,17 @@
 namespace keyplace::cli {
 
 /// ReadCarmenLogWithScans: a file without laser scans is an error naming it.
-inline CarmenLog ReadLogWithScans(const std::string& path) { return ReadCarmenLogWithScans(path); }
+inline CarmenLog ReadLogWithScans(const std::string& path, const CarmenReadOptions& options = {}) {
+  return ReadCarmenLogWithScans(path, options);
+}
+
+/// Help text of --skip-bad-lines (CarmenReadOptions::skip_bad_lines).
+inline constexpr const char* kSkipBadLinesHelp =
+    "Skip malformed log lines (counted and reported) instead of stopping at the first one";
+
+/// Prints the reader's warnings about a log (a dropped cut-off last line, skipped lines) to
+/// stderr, one "keyplace: warning: ..." line each.
+void PrintLogWarnings(const CarmenLog& log);
 
 /// Seconds since `start` (steady clock).
 double SecondsSince(std::chrono::steady_clock::time_point start);

@@ -23,6 +23,7 @@ namespace {
 struct InfoOptions {
   std::string input;
   std::string json_path;
+  bool skip_bad_lines = false;
 };
 
 double PathLength(const CarmenLog& log) {
@@ -80,6 +81,9 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
   json["graph_loop_edges"] =
       std::count_if(log.edges.begin(), log.edges.end(), [](const GraphEdge& e) { return e.loop; });
   json["line_counts"] = log.line_counts;
+  json["skipped_lines"] = log.skipped_lines;
+  json["truncated_last_line"] = log.truncated_last_line;
+  json["warnings"] = log.warnings;
   return json;
 }
 
@@ -190,7 +194,11 @@ void RunInfo(const InfoOptions& options) {
     json = DescribeMap(options.input, LoadMap(options.input));
     PrintMap(json);
   } else {
-    json = DescribeLog(ReadLogWithScans(options.input));
+    CarmenReadOptions reading;
+    reading.skip_bad_lines = options.skip_bad_lines;
+    const CarmenLog log = ReadLogWithScans(options.input, reading);
+    PrintLogWarnings(log);
+    json = DescribeLog(log);
     PrintLog(json);
   }
   if (!options.json_path.empty()) WriteJson(options.json_path, json);
@@ -208,6 +216,7 @@ void RegisterInfoCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--json", options->json_path, "Also write the figures as JSON to FILE");
+  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   command->callback([options] { RunInfo(*options); });
 }
 

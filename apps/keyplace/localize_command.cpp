@@ -43,6 +43,7 @@ struct LocalizeOptions {
   std::optional<double> min_confidence;
   int n_pos = 500;
   bool exclude_shared_scans = false;
+  bool skip_bad_lines = false;
 };
 
 // The everyday flags as configuration assignments (--gamma-min sets both thresholds).
@@ -81,10 +82,12 @@ void RunLocalize(const LocalizeOptions& options) {
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
 
   LogInputOptions input_options;
+  input_options.reading.skip_bad_lines = options.skip_bad_lines;
   input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
   const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
+  PrintLogWarnings(inputs.log);
   const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
                                             options.truth_path, options.index_path);
   const std::string map_log_path =
@@ -202,6 +205,7 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--json", options->json_path, "Write the figures as JSON to FILE");
   command->add_option("--queries", options->queries_path, "Write one TSV row per query to FILE");
   command->add_option("--curve", options->curve_path, "Write the precision-recall curve (TSV)");
+  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   command->callback([options] { RunLocalize(*options); });
 }
 

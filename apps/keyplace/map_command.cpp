@@ -33,6 +33,7 @@ struct MapOptions {
   std::string svg_path;
   ConfigOptions config;
   bool overlap_only = false;
+  bool skip_bad_lines = false;
 };
 
 void RunMap(const MapOptions& options) {
@@ -44,10 +45,12 @@ void RunMap(const MapOptions& options) {
     }
   });
   LogInputOptions input_options;
+  input_options.reading.skip_bad_lines = options.skip_bad_lines;
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
+  PrintLogWarnings(inputs.log);
   const CarmenLog& log = inputs.log;
   const PoseSource source = inputs.pose_source;
   const double read_seconds = inputs.seconds_read;
@@ -184,6 +187,7 @@ void RegisterMapCommand(CLI::App& app) {
   command->add_flag("--overlap-only", options->overlap_only,
                     "Complete submaps on the overlap criterion alone (paper Section 3.1.3, as "
                     "for Table II): no distribution or keypoint-count criterion");
+  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   AddConfigOptions(command, options->config);
   command->callback([options] { RunMap(*options); });
 }

@@ -36,6 +36,7 @@ class LineReader {
       line.append(chunk);
       if (!line.empty() && line.back() == '\n') break;
     }
+    terminated_ = !line.empty() && line.back() == '\n';
     int error_code = Z_OK;
     const char* message = gzerror(file_, &error_code);
     if (error_code != Z_OK && error_code != Z_STREAM_END) {
@@ -49,11 +50,14 @@ class LineReader {
   }
 
   std::size_t line_number() const { return line_number_; }
+  // Whether the latest line ended with an end of line (only the file's last line may not).
+  bool terminated() const { return terminated_; }
 
  private:
   std::string path_;
   gzFile file_;
   std::size_t line_number_ = 0;
+  bool terminated_ = true;
 };
 
 void Tokenize(std::string_view line, std::vector<std::string_view>& tokens) {
@@ -381,12 +385,47 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   LineReader reader(path);
   std::string line;
   std::vector<std::string_view> tokens;
+  CarmenLog& log = state.log;
+  std::string first_skipped_error;
   while (reader.Next(line)) {
     Tokenize(line, tokens);
     if (tokens.empty()) continue;
-    ParseLine(path, reader.line_number(), tokens, state);
+    try {
+      ParseLine(path, reader.line_number(), tokens, state);  // changes nothing when it throws
+    } catch (const std::invalid_argument& error) {
+      if (!reader.terminated()) {  // the last line, cut off
+        const std::string where = path + ":" + std::to_string(reader.line_number()) + ": ";
+        std::string what = error.what();
+        if (what.compare(0, where.size(), where) == 0) what.erase(0, where.size());
+        log.truncated_last_line = true;
+        std::string warning = where;
+        warning.append("the last line is incomplete (no end of line) and was dropped (")
+            .append(what)
+            .append(")");
+        log.warnings.push_back(std::move(warning));
+      } else if (options.skip_bad_lines) {
+        if (log.skipped_lines == 0) first_skipped_error = error.what();
+        ++log.skipped_lines;
+        if (log.skipped_line_numbers.size() < CarmenLog::kMaxListedSkippedLines) {
+          log.skipped_line_numbers.push_back(reader.line_number());
+        }
+      } else {
+        throw std::invalid_argument(std::string(error.what()) +
+                                    " (to skip malformed lines: --skip-bad-lines, "
+                                    "CarmenReadOptions::skip_bad_lines)");
+      }
+    }
   }
-  CarmenLog& log = state.log;
+  if (log.skipped_lines > 0) {
+    std::string numbers;
+    for (const std::size_t number : log.skipped_line_numbers) {
+      numbers += (numbers.empty() ? "" : ", ") + std::to_string(number);
+    }
+    if (log.skipped_lines > log.skipped_line_numbers.size()) numbers += ", ...";
+    log.warnings.push_back(path + ": skipped " + std::to_string(log.skipped_lines) +
+                           (log.skipped_lines == 1 ? " malformed line" : " malformed lines") +
+                           " (line " + numbers + "); the first: " + first_skipped_error);
+  }
   log.lines = reader.line_number();
   switch (options.pose_kind) {
     case CarmenReadOptions::PoseKind::kCorrected:

@@ -87,7 +87,7 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
                            const StageProgress& progress) {
   auto start = std::chrono::steady_clock::now();
   LogInputs inputs;
-  inputs.log = ReadCarmenLogWithScans(path);
+  inputs.log = ReadCarmenLogWithScans(path, options.reading);
   std::vector<LogScan>& scans = inputs.log.scans;
   inputs.file_scans = scans.size();
   const std::size_t end = std::min(options.end_scan, scans.size());

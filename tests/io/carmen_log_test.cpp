@@ -229,6 +229,80 @@ TEST(CarmenLog, MoreBeamsThanRealLidarsGiveIsAnErrorNamingTheLine) {
   EXPECT_EQ(ReadCarmenLog(most).scans.at(0).size(), kMaxScanBeams);
 }
 
+TEST(CarmenLog, CutOffLastLineIsDroppedWithAWarning) {
+  const std::string complete = Flaser(4, "1.5", "0 0 0 0 0 0 1 h 1");
+  std::string cut = Flaser(4, "1.5", "0 0 0 0 0 0 2 h 2");
+  cut = cut.substr(0, cut.size() / 2);  // no end of line, too few fields
+  const std::string path = WriteText("cut.log", complete + complete + cut);
+  const CarmenLog log = ReadCarmenLog(path);
+  EXPECT_EQ(log.scans.size(), 2u);
+  EXPECT_TRUE(log.truncated_last_line);
+  ASSERT_EQ(log.warnings.size(), 1u);
+  EXPECT_NE(log.warnings[0].find(path + ":3"), std::string::npos) << log.warnings[0];
+  EXPECT_NE(log.warnings[0].find("incomplete"), std::string::npos) << log.warnings[0];
+  EXPECT_EQ(log.skipped_lines, 0u);
+  // A complete last line without end of line is kept, silently.
+  const std::string unterminated = complete.substr(0, complete.size() - 1);
+  const CarmenLog kept = ReadCarmenLog(WriteText("unterminated.log", complete + unterminated));
+  EXPECT_EQ(kept.scans.size(), 2u);
+  EXPECT_FALSE(kept.truncated_last_line);
+  EXPECT_TRUE(kept.warnings.empty());
+  // A cut-off line anywhere else is a malformed line: an error.
+  const std::string middle = WriteText("middle.log", complete + cut + "\n" + complete);
+  ExpectError<std::invalid_argument>(middle, {middle + ":2", "--skip-bad-lines"});
+}
+
+// Formerly the whole log was rejected because its last line was cut off (a logger killed by
+// power loss): the first 400 000 bytes of FR101 end in the middle of a FLASER line.
+TEST(CarmenLog, CutOffSharedLogKeepsEveryCompleteLine) {
+  const std::string source = testing::SharedFile("data/fr101-corrected.log.gz");
+  gzFile in = gzopen(source.c_str(), "rb");
+  ASSERT_NE(in, nullptr);
+  std::string text(400000, '\0');
+  ASSERT_EQ(gzread(in, text.data(), static_cast<unsigned>(text.size())), 400000);
+  gzclose(in);
+  ASSERT_NE(text.back(), '\n');
+  const std::string path = testing::MakeTempDir("carmen-cut") + "/fr101-cut.log";
+  std::ofstream(path, std::ios::binary) << text;
+  std::size_t complete_scans = 0;
+  for (std::size_t start = 0, end; (end = text.find('\n', start)) != std::string::npos;
+       start = end + 1) {
+    if (text.compare(start, 7, "FLASER ") == 0) ++complete_scans;
+  }
+  const CarmenLog log = ReadCarmenLog(path);
+  EXPECT_EQ(log.scans.size(), complete_scans);
+  EXPECT_EQ(complete_scans, 146u);
+  EXPECT_TRUE(log.corrected);
+  EXPECT_TRUE(log.truncated_last_line);
+  ASSERT_EQ(log.warnings.size(), 1u);
+  EXPECT_NE(log.warnings[0].find("FLASER"), std::string::npos) << log.warnings[0];
+}
+
+TEST(CarmenLog, MalformedLinesStopTheReadingUnlessSkipped) {
+  const std::string good = Flaser(4, "1.5", "0 0 0 0 0 0 1 h 1");
+  std::string text = good;
+  for (int k = 0; k < 12; ++k) text += "ODOM 1 2 3\n" + good;  // 12 bad lines: 2, 4, ..., 24
+  const std::string path = WriteText("bad_lines.log", text);
+  ExpectError<std::invalid_argument>(path, {path + ":2", "ODOM", "--skip-bad-lines"});
+  CarmenReadOptions skip;
+  skip.skip_bad_lines = true;
+  const CarmenLog log = ReadCarmenLog(path, skip);
+  EXPECT_EQ(log.scans.size(), 13u);
+  EXPECT_EQ(log.skipped_lines, 12u);
+  ASSERT_EQ(log.skipped_line_numbers.size(), CarmenLog::kMaxListedSkippedLines);
+  EXPECT_EQ(log.skipped_line_numbers.front(), 2u);
+  EXPECT_EQ(log.skipped_line_numbers.back(), 20u);
+  EXPECT_EQ(log.scans.back().line, 25u);
+  EXPECT_EQ(log.line_counts.count("ODOM"), 0u);  // a skipped line leaves no trace
+  ASSERT_EQ(log.warnings.size(), 1u);
+  EXPECT_NE(log.warnings[0].find("skipped 12 malformed lines (line 2, 4,"), std::string::npos)
+      << log.warnings[0];
+  EXPECT_NE(log.warnings[0].find(path + ":2: ODOM"), std::string::npos) << log.warnings[0];
+  // A far pose or a bad field of view is a malformed line too.
+  const std::string far = WriteText("far_skip.log", good + Flaser(2, "1", "0 0 0 3e8 0 0 1 h 1"));
+  EXPECT_EQ(ReadCarmenLog(far, skip).scans.size(), 1u);
+}
+
 TEST(CarmenLog, TruncatedGzipIsAnError) {
   const std::string dir = testing::MakeTempDir("carmen-gz");
   const std::string path = dir + "/truncated.log.gz";

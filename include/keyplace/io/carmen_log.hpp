@@ -63,6 +63,17 @@ struct CarmenLog {
   // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
   // stored in LogScan::corrected_pose instead of odometry_pose.
   bool corrected = false;
+  // Damage the reader worked around, one sentence each, naming file and line (the library never
+  // prints: callers show them).
+  std::vector<std::string> warnings;
+  // The last line had no end of line and did not parse (a logger cut off, e.g. by power loss):
+  // it was dropped.
+  bool truncated_last_line = false;
+  // Malformed lines skipped with CarmenReadOptions::skip_bad_lines: how many, and the first
+  // kMaxListedSkippedLines of their line numbers.
+  std::size_t skipped_lines = 0;
+  std::vector<std::size_t> skipped_line_numbers;
+  static constexpr std::size_t kMaxListedSkippedLines = 10;
 };
 
 struct CarmenReadOptions {
@@ -75,10 +86,15 @@ struct CarmenReadOptions {
   double max_coordinate_m = 1e7;
   // Overrides the decision taken from the file content (VERTEX2 / NEFF lines) when set.
   enum class PoseKind { kAuto, kCorrected, kOdometry } pose_kind = PoseKind::kAuto;
+  // Skip malformed lines (counted in CarmenLog::skipped_lines, with a warning) instead of
+  // stopping at the first one.
+  bool skip_bad_lines = false;
 };
 
 /// Reads a CARMEN log. Throws std::invalid_argument naming file, line and field on malformed
-/// input, std::runtime_error when the file cannot be opened or is truncated.
+/// input (unless options.skip_bad_lines), std::runtime_error when the file cannot be opened or
+/// its compressed data are truncated. A last line without end of line that does not parse is
+/// dropped with a warning (CarmenLog::warnings): what a logger killed mid-line leaves.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
 /// ReadCarmenLog, and throws std::invalid_argument naming the file when it holds no laser scan

@@ -43,6 +43,7 @@ Pose2 LogLaserPose(const LogScan& scan);
 
 /// What to prepare from a log.
 struct LogInputOptions {
+  CarmenReadOptions reading;        // how the log is read (e.g. skip_bad_lines)
   std::optional<PoseSource> poses;  // default: corrected when the log has them, else icp
   ScanOdometryConfig odometry;      // for PoseSource::kIcp
   FlirtConfig features;
@@ -58,7 +59,7 @@ using StageProgress = std::function<void(const std::string&, std::size_t, std::s
 /// A log read and prepared for mapping and place recognition: its scans, a pose per scan and
 /// the FLIRT keypoints of every scan, with where they came from.
 struct LogInputs {
-  CarmenLog log;  // scans cut to the requested range
+  CarmenLog log;  // scans cut to the requested range; log.warnings: damage the reader skipped
   PoseSource pose_source = PoseSource::kCorrected;
   std::vector<Pose2> poses;                      // T_world_robot of every scan
   std::vector<std::vector<Keypoint>> keypoints;  // laser frame
