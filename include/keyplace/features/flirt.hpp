@@ -63,9 +63,9 @@ struct FlirtSignals {
 
 /// FLIRT detector + beta-grid descriptor. Immutable after construction; all methods are const
 /// and thread-safe: scratch buffers live in a per-thread workspace that is reused between calls
-/// (about 100 bytes per valid beam plus 20 per pair of valid beams within the kernel cutoff of
-/// the largest scale: 4 MiB for 360 beams, 57 MiB for 8192 beams in a 40 m room, 650 MiB when
-/// all 8192 lie within the cutoff of each other).
+/// (a few hundred bytes per valid beam plus 20 per pair of valid beams within the kernel cutoff
+/// of the largest scale: 57 MiB for 8192 beams in a 40 m room, 650 MiB when all 8192 lie within
+/// the cutoff of each other; docs/RELIABILITY.md).
 class FlirtExtractor {
  public:
   explicit FlirtExtractor(FlirtConfig config = {});
