@@ -31,6 +31,14 @@ import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['keypoints_per_scan_mean'] > 5 and j['seconds_per_scan_mean'] > 0" "$work/kp.json"
 
+check "features --set" "$keyplace" features "$log" --scans 0:5 --set features.num_scales=3 \
+  --json "$work/kp3.json"
+check "features --set json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert len(j['keypoints_per_level']) == 3 and j['config']['features']['num_scales'] == '3', j" \
+  "$work/kp3.json"
+
 check "map" "$keyplace" map "$log" --out "$work/map.kpm" --json "$work/map.json" --png "$work/map.png"
 check "map json keys" python3 -c "
 import json,sys
