@@ -104,21 +104,24 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   inputs.seconds_read = SecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  inputs.pose_source = options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected
-                                                                   : PoseSource::kIcp);
-  const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
-  inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
-                           [&](std::size_t done, std::size_t total) {
-                             if (progress) progress(pose_stage, done, total);
-                           });
-  inputs.seconds_poses = SecondsSince(start);
+  inputs.pose_source =
+      options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected : PoseSource::kIcp);
+  if (options.compute_poses) {
+    const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
+    inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
+                             [&](std::size_t done, std::size_t total) {
+                               if (progress) progress(pose_stage, done, total);
+                             });
+    inputs.seconds_poses = SecondsSince(start);
+  }
 
   if (options.keypoints) {
     start = std::chrono::steady_clock::now();
     const FlirtExtractor extractor(options.features);
-    inputs.keypoints = ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
-      if (progress) progress("keypoints", done, total);
-    });
+    inputs.keypoints =
+        ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
+          if (progress) progress("keypoints", done, total);
+        });
     inputs.seconds_keypoints = SecondsSince(start);
   }
   return inputs;
