@@ -106,12 +106,14 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   start = std::chrono::steady_clock::now();
   inputs.pose_source =
       options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected : PoseSource::kIcp);
-  const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
-  inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
-                           [&](std::size_t done, std::size_t total) {
-                             if (progress) progress(pose_stage, done, total);
-                           });
-  inputs.seconds_poses = SecondsSince(start);
+  if (options.compute_poses) {
+    const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
+    inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
+                             [&](std::size_t done, std::size_t total) {
+                               if (progress) progress(pose_stage, done, total);
+                             });
+    inputs.seconds_poses = SecondsSince(start);
+  }
 
   if (options.keypoints) {
     start = std::chrono::steady_clock::now();

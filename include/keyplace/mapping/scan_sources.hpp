@@ -50,6 +50,8 @@ struct LogInputOptions {
   std::size_t first_scan = 0;
   std::size_t end_scan = static_cast<std::size_t>(-1);
   bool keypoints = true;  // false: leave LogInputs::keypoints empty
+  // false: leave LogInputs::poses empty, for callers that estimate the poses themselves (SLAM)
+  bool compute_poses = true;
 };
 
 /// Progress of a preparation stage ("poses (icp)", "keypoints"): (stage, done, total).
@@ -60,7 +62,7 @@ using StageProgress = std::function<void(const std::string&, std::size_t, std::s
 struct LogInputs {
   CarmenLog log;  // scans cut to the requested range
   PoseSource pose_source = PoseSource::kCorrected;
-  std::vector<Pose2> poses;                      // T_world_robot of every scan
+  std::vector<Pose2> poses;                      // T_world_robot of every scan (if computed)
   std::vector<std::vector<Keypoint>> keypoints;  // laser frame
   std::string source_log;                        // file name of the log
   std::string source_hash;                       // FileFingerprint of the log
