@@ -1,9 +1,11 @@
 #include "keyplace/mapping/local_mapper.hpp"
 
 #include <cmath>
+#include <utility>
 
 #include <gtest/gtest.h>
 
+#include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 
 namespace keyplace {
@@ -132,11 +134,13 @@ TEST(GlobalMapper, SubmapsAreConsecutiveAndStopAtTheEnd) {
   MappingConfig config;
   config.use_distribution = false;
   config.min_stable_keypoints = 0;
-  std::vector<LaserScan> scans;
+  std::vector<LogScan> scans;
   std::vector<Pose2> poses;
   for (int k = 0; k < 80; ++k) {
     poses.emplace_back(-8.0 + 0.2 * k, 0.0, 0.0);
-    scans.push_back(SquareRoomScan(poses.back(), 10.0, 180));
+    LogScan scan;
+    static_cast<LaserScan&>(scan) = SquareRoomScan(poses.back(), 10.0, 180);
+    scans.push_back(std::move(scan));
   }
   const std::vector<std::vector<Keypoint>> keypoints(scans.size());
   const ScanSequence sequence{scans, poses, keypoints};
