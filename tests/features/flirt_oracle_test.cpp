@@ -31,7 +31,7 @@ const CarmenLog& LoadLog(const std::string& dataset) {
 }
 
 // The laser pose as printed in the log (see flirt_reference_test.cpp).
-Pose2 LaserPose(const LaserScan& scan) {
+Pose2 LaserPose(const LogScan& scan) {
   const Pose2 pose = *scan.corrected_pose * scan.T_robot_laser;
   const auto snap = [](double value) { return std::round(value * 1e6) / 1e6; };
   return {snap(pose.x), snap(pose.y), snap(pose.theta)};

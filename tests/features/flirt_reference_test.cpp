@@ -106,7 +106,7 @@ const CarmenLog& LoadLog(const std::string& dataset) {
 // decimals). Our reader keeps the robot pose and T_robot_laser; their product differs from the
 // printed values by a few ulps, which is enough to flip near-equal edge lengths in the spanning
 // trees of a handful of scans. Snapping back to the printed grid gives FLIRTLib's exact input.
-Pose2 LaserPose(const LaserScan& scan) {
+Pose2 LaserPose(const LogScan& scan) {
   const Pose2 pose = *scan.corrected_pose * scan.T_robot_laser;
   const auto snap = [](double value) { return std::round(value * 1e6) / 1e6; };
   return {snap(pose.x), snap(pose.y), snap(pose.theta)};
