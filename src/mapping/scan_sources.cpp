@@ -127,4 +127,27 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   return inputs;
 }
 
+LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
+              const std::function<void(std::size_t)>& progress) {
+  LogMap result;
+  result.map = BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, config,
+                              &result.timings, progress);
+  result.map.source_log = inputs.source_log;
+  result.map.source_hash = inputs.source_hash;
+  result.map.pose_source = ToString(inputs.pose_source);
+  result.stats = ComputeStats(result.map);
+  const std::vector<double>& seconds = result.timings.submap_seconds;
+  if (!seconds.empty()) {
+    double sum = 0.0;
+    for (const double s : seconds) sum += s;
+    result.seconds_per_submap_mapping = sum / static_cast<double>(seconds.size());
+  }
+  if (result.stats.submaps > 0) {
+    result.seconds_per_submap =
+        result.seconds_per_submap_mapping + (inputs.seconds_poses + inputs.seconds_keypoints) /
+                                                static_cast<double>(result.stats.submaps);
+  }
+  return result;
+}
+
 }  // namespace keyplace

@@ -11,6 +11,8 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
 
 namespace keyplace {
@@ -77,5 +79,19 @@ struct LogInputs {
 /// computes the poses and the keypoints. `progress` may be empty.
 LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options = {},
                            const StageProgress& progress = {});
+
+/// A log's global map (Algorithm 2) with its provenance and the mapping criteria of Section 5.1.
+struct LogMap {
+  GlobalMap map;  // source_log, source_hash, pose_source set from the inputs
+  MappingStats stats;
+  GlobalMappingTimings timings;
+  double seconds_per_submap_mapping = 0.0;  // mean time to build a submap (keypoints given)
+  // ... plus each submap's share of the pose estimation and keypoint extraction.
+  double seconds_per_submap = 0.0;
+};
+
+/// Builds the map of `inputs` with `config`; `progress` (may be empty) gets the next scan index.
+LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
+              const std::function<void(std::size_t)>& progress = {});
 
 }  // namespace keyplace
