@@ -35,4 +35,19 @@ bool SymmetricChi2Below(const BetaGridDescriptor& a, const BetaGridDescriptor& b
   return 0.5 * sum < threshold;
 }
 
+double SymmetricChi2IfBelow(const BetaGridDescriptor& a, const BetaGridDescriptor& b,
+                            double threshold) {
+  // The sum of SymmetricChi2 in its order; partial sums never decrease (non-negative terms), so
+  // stopping where SymmetricChi2Below stops rejects exactly the pairs it rejects.
+  const double limit = 2.0 * threshold;
+  double sum = 0.0;
+  for (int phi = 0; phi < kBetaGridPhiBins; ++phi) {
+    const int base = phi * kBetaGridRhoBins;
+    for (int rho = 0; rho < kBetaGridRhoBins; ++rho) sum += Chi2Term(a[base + rho], b[base + rho]);
+    if (sum >= limit) return std::numeric_limits<double>::infinity();
+  }
+  const double distance = 0.5 * sum;
+  return distance < threshold ? distance : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace keyplace

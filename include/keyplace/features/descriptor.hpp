@@ -23,4 +23,9 @@ double SymmetricChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b);
 /// threshold (all terms are non-negative). For hot matching loops.
 bool SymmetricChi2Below(const BetaGridDescriptor& a, const BetaGridDescriptor& b, double threshold);
 
+/// SymmetricChi2(a, b), bit for bit, when SymmetricChi2Below(a, b, threshold); otherwise +inf,
+/// with the same early stop. One pass where a pair needs both the test and the distance.
+double SymmetricChi2IfBelow(const BetaGridDescriptor& a, const BetaGridDescriptor& b,
+                            double threshold);
+
 }  // namespace keyplace
