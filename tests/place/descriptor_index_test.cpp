@@ -154,6 +154,41 @@ TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnTheBundledLog) {
   EXPECT_GT(check.max_ratio, 1.99);  // real descriptors with disjoint supports
 }
 
+// The distance as FLIRTLib writes it (a zero bin replaced by PSEUDOZERO in a branch), summed in
+// the same order: SymmetricChi2 (branch-free) must give the same doubles. (Here rather than in
+// tests/features: the index's results rest on it.)
+double FlirtLibChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b) {
+  const double pseudo_zero = std::numeric_limits<double>::min();
+  double sum = 0.0;
+  for (int i = 0; i < kBetaGridBins; ++i) {
+    const double q = a[i] == 0.0f ? pseudo_zero : static_cast<double>(a[i]);
+    const double p = b[i] == 0.0f ? pseudo_zero : static_cast<double>(b[i]);
+    sum += (q - p) * (q - p) / (q + p);
+  }
+  return 0.5 * sum;
+}
+
+TEST(DescriptorIndexBound, Chi2IsBitIdenticalToFlirtLibsBranchingPseudoZero) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  const float tiny = std::numeric_limits<float>::denorm_min();
+  for (int trial = 0; trial < 20000; ++trial) {
+    BetaGridDescriptor a;
+    BetaGridDescriptor b;
+    for (int i = 0; i < kBetaGridBins; ++i) {
+      const float u = uniform(rng);
+      a[i] = u < 0.5f ? 0.0f : (u < 0.52f ? tiny : (u < 0.53f ? -0.0f : uniform(rng)));
+      b[i] = uniform(rng) < 0.5f ? 0.0f : uniform(rng) * 1e-3f;
+    }
+    ASSERT_EQ(SymmetricChi2(a, b), FlirtLibChi2(a, b));
+    ASSERT_EQ(SymmetricChi2(b, a), FlirtLibChi2(b, a));
+  }
+  const std::vector<BetaGridDescriptor>& real = BundledLog().descriptors;
+  for (std::size_t k = 0; k + 1 < real.size(); ++k) {
+    ASSERT_EQ(SymmetricChi2(real[k], real[k + 1]), FlirtLibChi2(real[k], real[k + 1]));
+  }
+}
+
 TEST(DescriptorIndexBound, Chi2IfBelowIsTheChi2OrInfinity) {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> support(0, kBetaGridBins);

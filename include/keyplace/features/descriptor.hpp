@@ -16,7 +16,7 @@ using BetaGridDescriptor = std::array<float, kBetaGridBins>;
 
 /// FLIRTLib's symmetric chi-squared distance: sum over bins of 0.5 (q - p)^2 / (q + p), where a
 /// zero bin is replaced by the smallest positive normal double (FLIRTLib's PSEUDOZERO). Lies in
-/// [0, 1] for normalised histograms; 0 for identical ones.
+/// [0, 1] for normalised histograms; 0 for identical ones. Bins must be >= 0 (histograms).
 double SymmetricChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b);
 
 /// SymmetricChi2(a, b) < threshold, but stops summing as soon as the partial sum reaches the
