@@ -203,7 +203,8 @@ void BM_ScanOdometry(benchmark::State& state, const std::string& name) {
       k = 0;
       state.ResumeTiming();
     }
-    benchmark::DoNotOptimize(odometry->Add(log->scans[k++]));
+    const keyplace::LogScan& scan = log->scans[k++];
+    benchmark::DoNotOptimize(odometry->Add(scan, scan.odometry_pose));
   }
 }
 BENCHMARK_CAPTURE(BM_ScanOdometry, intel_180, std::string("intel"))->Unit(benchmark::kMicrosecond);

@@ -25,5 +25,13 @@ echo "== Global localization against that map (paper Algorithm 4, Table III)"
 "$keyplace" localize --map "$out/map.kpm" --log "$log" --json "$out/localize.json" \
   --queries "$out/localize-queries.tsv" --curve "$out/localize-curve.tsv"
 echo
+echo "== The same log streamed scan by scan through the library's GlobalLocalizer"
+echo "   (examples/localize_stream.cpp: what a robot program calls; first fixes and the count)"
+stream="$(dirname "$keyplace")/localize_stream"
+"$stream" "$out/map.kpm" "$log" --truth >"$out/localize-stream.txt"
+head -3 "$out/localize-stream.txt"
+echo "..."
+tail -1 "$out/localize-stream.txt"
+echo
 echo "Outputs in $out: info.json, features.json, keypoints.tsv, map-table2.json, map.kpm, map.png,"
-echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv"
+echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv, localize-stream.txt"

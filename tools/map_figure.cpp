@@ -62,17 +62,10 @@ void SubmapColour(cairo_t* cr, int id) {
   cairo_set_source_rgb(cr, 0.85 * r, 0.85 * g, 0.85 * b);
 }
 
-}  // namespace
-
-void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vector<LogScan>& scans,
-                   const std::vector<Pose2>& poses, const MapFigureOptions& options) {
-  const bool svg = EndsWith(path, ".svg");
-  if (!svg && !EndsWith(path, ".png")) {
-    throw std::invalid_argument(path + ": figure file name must end in .png or .svg");
-  }
-  // World points of the scans that went into submaps (every other beam is plenty to look at).
+// World points of the scans that went into submaps (every other beam is plenty to look at).
+std::vector<Eigen::Vector2d> MapScanPoints(const GlobalMap& map, const std::vector<LogScan>& scans,
+                                           const std::vector<Pose2>& poses) {
   std::vector<Eigen::Vector2d> points;
-  Bounds bounds;
   for (const Submap& submap : map.submaps) {
     for (const int index : submap.scan_indices) {
       if (index < 0 || static_cast<std::size_t>(index) >= scans.size() ||
@@ -84,52 +77,68 @@ void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vec
       for (std::size_t b = 0; b < scan.size(); b += 2) {
         if (scan.valid[b] == 0 || scan.ranges_m[b] > 30.0) continue;
         points.push_back(T_world_laser * scan.Endpoint(b));
-        bounds.Add(points.back());
       }
     }
   }
+  return points;
+}
+
+// The world rectangle of the figure: scan points, submap origins and stable keypoints.
+Bounds MapBounds(const GlobalMap& map, const std::vector<Eigen::Vector2d>& points) {
+  Bounds bounds;
+  for (const Eigen::Vector2d& point : points) bounds.Add(point);
   for (const Submap& submap : map.submaps) {
     bounds.Add(submap.origin().translation());
     for (const auto& keypoint : submap.keypoints) bounds.Add(submap.origin() * keypoint.position_m);
   }
   if (bounds.empty()) bounds.Add({0, 0});
-  const double margin_m = 1.0;
-  const double width_m = bounds.max_x - bounds.min_x + 2 * margin_m;
-  const double height_m = bounds.max_y - bounds.min_y + 2 * margin_m;
-  const double scale =
-      std::min(options.pixels_per_m, options.max_side_px / std::max(width_m, height_m));
-  const int header_px = 36;
-  const int width_px = static_cast<int>(std::ceil(width_m * scale));
-  const int height_px = static_cast<int>(std::ceil(height_m * scale)) + header_px;
+  return bounds;
+}
 
-  const std::filesystem::path target(path);
-  const std::string temporary =
-      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
-  cairo_surface_t* surface =
-      svg ? cairo_svg_surface_create(temporary.c_str(), width_px, height_px)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px);
-  cairo_t* cr = cairo_create(surface);
-  const auto to_px = [&](const Eigen::Vector2d& p) {
-    return Eigen::Vector2d((p.x() - bounds.min_x + margin_m) * scale,
-                           header_px + (bounds.max_y + margin_m - p.y()) * scale);
-  };
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
+// Where the world goes on the figure: a header strip, then the bounds with a margin.
+struct MapLayout {
+  Bounds bounds;
+  double margin_m = 1.0;
+  double scale = 1.0;  // px per m
+  int header_px = 36;
+  int width_px = 0;
+  int height_px = 0;
 
-  // Scan points, light.
+  Eigen::Vector2d Px(const Eigen::Vector2d& p) const {
+    return {(p.x() - bounds.min_x + margin_m) * scale,
+            header_px + (bounds.max_y + margin_m - p.y()) * scale};
+  }
+};
+
+MapLayout FitMap(const Bounds& bounds, const MapFigureOptions& options) {
+  MapLayout layout;
+  layout.bounds = bounds;
+  const double width_m = bounds.max_x - bounds.min_x + 2 * layout.margin_m;
+  const double height_m = bounds.max_y - bounds.min_y + 2 * layout.margin_m;
+  layout.scale = std::min(options.pixels_per_m, options.max_side_px / std::max(width_m, height_m));
+  layout.width_px = static_cast<int>(std::ceil(width_m * layout.scale));
+  layout.height_px = static_cast<int>(std::ceil(height_m * layout.scale)) + layout.header_px;
+  return layout;
+}
+
+// Scan points, light.
+void DrawScanPoints(cairo_t* cr, const MapLayout& layout,
+                    const std::vector<Eigen::Vector2d>& points) {
   cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 0.35);
-  const double dot = std::max(0.6, 0.03 * scale);
+  const double dot = std::max(0.6, 0.03 * layout.scale);
   for (const auto& point : points) {
-    const Eigen::Vector2d p = to_px(point);
+    const Eigen::Vector2d p = layout.Px(point);
     cairo_rectangle(cr, p.x() - dot / 2, p.y() - dot / 2, dot, dot);
   }
   cairo_fill(cr);
+}
 
-  // Trajectory through the submap origins.
+// Trajectory through the submap origins.
+void DrawTrajectory(cairo_t* cr, const MapLayout& layout, const GlobalMap& map) {
   cairo_set_source_rgba(cr, 0.1, 0.1, 0.1, 0.6);
   cairo_set_line_width(cr, 1.0);
   for (std::size_t s = 0; s < map.submaps.size(); ++s) {
-    const Eigen::Vector2d p = to_px(map.submaps[s].origin().translation());
+    const Eigen::Vector2d p = layout.Px(map.submaps[s].origin().translation());
     if (s == 0) {
       cairo_move_to(cr, p.x(), p.y());
     } else {
@@ -137,54 +146,67 @@ void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vec
     }
   }
   cairo_stroke(cr);
+}
 
-  // Stable keypoints, coloured by submap.
-  const double radius = std::max(1.5, 0.06 * scale);
+// Stable keypoints, coloured by submap.
+void DrawKeypoints(cairo_t* cr, const MapLayout& layout, const GlobalMap& map) {
+  const double radius = std::max(1.5, 0.06 * layout.scale);
   for (const Submap& submap : map.submaps) {
     SubmapColour(cr, submap.id);
     for (const auto& keypoint : submap.keypoints) {
-      const Eigen::Vector2d p = to_px(submap.origin() * keypoint.position_m);
+      const Eigen::Vector2d p = layout.Px(submap.origin() * keypoint.position_m);
       cairo_new_sub_path(cr);
       cairo_arc(cr, p.x(), p.y(), radius, 0, 2 * M_PI);
     }
     cairo_fill(cr);
   }
+}
 
-  // Submap origins: small black triangles pointing along the robot heading.
+// Submap origins: small black triangles pointing along the robot heading.
+void DrawOrigins(cairo_t* cr, const MapLayout& layout, const GlobalMap& map) {
   cairo_set_source_rgb(cr, 0, 0, 0);
+  const double scale = layout.scale;
   const double size = std::max(3.0, 0.15 * scale);
   for (const Submap& submap : map.submaps) {
     const Pose2& origin = submap.origin();
-    const Eigen::Vector2d tip = to_px(origin * Eigen::Vector2d(size / scale, 0));
-    const Eigen::Vector2d left = to_px(origin * Eigen::Vector2d(-size / scale, 0.6 * size / scale));
+    const Eigen::Vector2d tip = layout.Px(origin * Eigen::Vector2d(size / scale, 0));
+    const Eigen::Vector2d left =
+        layout.Px(origin * Eigen::Vector2d(-size / scale, 0.6 * size / scale));
     const Eigen::Vector2d right =
-        to_px(origin * Eigen::Vector2d(-size / scale, -0.6 * size / scale));
+        layout.Px(origin * Eigen::Vector2d(-size / scale, -0.6 * size / scale));
     cairo_move_to(cr, tip.x(), tip.y());
     cairo_line_to(cr, left.x(), left.y());
     cairo_line_to(cr, right.x(), right.y());
     cairo_close_path(cr);
   }
   cairo_fill(cr);
+}
 
-  // Header: title and a 5 m scale bar.
+// Header: title and a 5 m scale bar.
+void DrawHeader(cairo_t* cr, const MapLayout& layout, const GlobalMap& map,
+                const std::string& title_option) {
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
   cairo_set_font_size(cr, 14);
   cairo_move_to(cr, 8, 22);
   const std::string title =
-      options.title.empty()
+      title_option.empty()
           ? fmt::format("{} submaps, {} stable keypoints", map.submaps.size(), map.KeypointCount())
-          : options.title;
+          : title_option;
   cairo_show_text(cr, title.c_str());
-  const double bar_px = 5.0 * scale;
+  const double bar_px = 5.0 * layout.scale;
   cairo_set_line_width(cr, 2.0);
-  cairo_move_to(cr, width_px - bar_px - 10, 24);
-  cairo_line_to(cr, width_px - 10, 24);
+  cairo_move_to(cr, layout.width_px - bar_px - 10, 24);
+  cairo_line_to(cr, layout.width_px - 10, 24);
   cairo_stroke(cr);
-  cairo_move_to(cr, width_px - bar_px - 10, 16);
+  cairo_move_to(cr, layout.width_px - bar_px - 10, 16);
   cairo_show_text(cr, "5 m");
+}
 
-  cairo_destroy(cr);
+// Writes `surface` (its SVG already streams to `temporary`) and renames `temporary` to `path`;
+// destroys the surface.
+void FinishFigure(cairo_surface_t* surface, bool svg, const std::string& temporary,
+                  const std::string& path) {
   cairo_status_t status = CAIRO_STATUS_SUCCESS;
   if (svg) {
     cairo_surface_finish(surface);
@@ -198,8 +220,37 @@ void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vec
     std::filesystem::remove(temporary, error);
     throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
   }
-  std::filesystem::rename(temporary, target, error);
+  std::filesystem::rename(temporary, path, error);
   if (error) throw std::runtime_error(path + ": cannot rename figure: " + error.message());
+}
+
+}  // namespace
+
+void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vector<LogScan>& scans,
+                   const std::vector<Pose2>& poses, const MapFigureOptions& options) {
+  const bool svg = EndsWith(path, ".svg");
+  if (!svg && !EndsWith(path, ".png")) {
+    throw std::invalid_argument(path + ": figure file name must end in .png or .svg");
+  }
+  const std::vector<Eigen::Vector2d> points = MapScanPoints(map, scans, poses);
+  const MapLayout layout = FitMap(MapBounds(map, points), options);
+
+  const std::filesystem::path target(path);
+  const std::string temporary =
+      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
+  cairo_surface_t* surface =
+      svg ? cairo_svg_surface_create(temporary.c_str(), layout.width_px, layout.height_px)
+          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, layout.width_px, layout.height_px);
+  cairo_t* cr = cairo_create(surface);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  DrawScanPoints(cr, layout, points);
+  DrawTrajectory(cr, layout, map);
+  DrawKeypoints(cr, layout, map);
+  DrawOrigins(cr, layout, map);
+  DrawHeader(cr, layout, map, options.title);
+  cairo_destroy(cr);
+  FinishFigure(surface, svg, temporary, path);
 }
 
 }  // namespace keyplace::cli

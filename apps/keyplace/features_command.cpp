@@ -1,7 +1,6 @@
 // keyplace features LOG: FLIRT keypoints of every scan of a log.
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -13,8 +12,9 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
-#include "keyplace/features/flirt.hpp"
+#include "config_options.hpp"
 #include "io/atomic_file.hpp"
+#include "keyplace/features/flirt.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 
@@ -26,12 +26,14 @@ struct FeaturesOptions {
   std::string scans = ":";
   std::string tsv_path;
   std::string json_path;
+  ConfigOptions config;
 };
 
 void RunFeatures(const FeaturesOptions& options) {
+  const Config config = ResolveConfig(options.config);
   const CarmenLog log = ReadLogWithScans(options.input);
   const ScanRange range = ParseScanRange(options.scans, log.scans.size());
-  const FlirtExtractor extractor;
+  const FlirtExtractor extractor(config.features);
 
   std::vector<std::vector<Keypoint>> keypoints(range.end - range.begin);
   Progress progress("features", keypoints.size());
@@ -46,13 +48,15 @@ void RunFeatures(const FeaturesOptions& options) {
   progress.Finish();
 
   std::vector<std::size_t> counts;
-  std::array<std::size_t, 8> per_level{};
+  const std::size_t levels = static_cast<std::size_t>(extractor.config().num_scales);
+  std::vector<std::size_t> per_level(levels, 0);
   std::size_t total = 0;
   for (const auto& scan_keypoints : keypoints) {
     counts.push_back(scan_keypoints.size());
     total += scan_keypoints.size();
     for (const auto& keypoint : scan_keypoints) {
-      if (keypoint.scale_level >= 0 && keypoint.scale_level < 8) ++per_level[keypoint.scale_level];
+      const auto level = static_cast<std::size_t>(keypoint.scale_level);
+      if (keypoint.scale_level >= 0 && level < levels) ++per_level[level];
     }
   }
   const std::size_t scans = counts.size();
@@ -64,7 +68,6 @@ void RunFeatures(const FeaturesOptions& options) {
                             ? static_cast<double>(sorted[scans / 2])
                             : 0.5 * static_cast<double>(sorted[scans / 2 - 1] + sorted[scans / 2]);
   const double seconds_per_scan = scans > 0 ? seconds_total / static_cast<double>(scans) : 0.0;
-  const std::size_t levels = static_cast<std::size_t>(extractor.config().num_scales);
 
   fmt::print("log                 {}\n", options.input);
   fmt::print("scans               {} (of {}, range {}:{})\n", scans, log.scans.size(), range.begin,
@@ -73,7 +76,7 @@ void RunFeatures(const FeaturesOptions& options) {
   fmt::print("per scan            mean {:.2f}, median {:.1f}, min {}, max {}\n", mean, median,
              scans > 0 ? sorted.front() : 0, scans > 0 ? sorted.back() : 0);
   std::string level_text;
-  for (std::size_t level = 0; level < levels && level < per_level.size(); ++level) {
+  for (std::size_t level = 0; level < levels; ++level) {
     level_text += fmt::format("{}{}", level == 0 ? "" : " / ", per_level[level]);
   }
   fmt::print("per scale level     {}\n", level_text);
@@ -103,10 +106,10 @@ void RunFeatures(const FeaturesOptions& options) {
     json["keypoints_per_scan_median"] = median;
     json["keypoints_per_scan_min"] = scans > 0 ? sorted.front() : 0;
     json["keypoints_per_scan_max"] = scans > 0 ? sorted.back() : 0;
-    json["keypoints_per_level"] = std::vector<std::size_t>(
-        per_level.begin(), per_level.begin() + std::min<std::size_t>(levels, per_level.size()));
+    json["keypoints_per_level"] = per_level;
     json["seconds_per_scan_mean"] = seconds_per_scan;
     json["seconds_total"] = seconds_total;
+    json["config"] = ConfigJson(config);
     WriteJson(options.json_path, json);
   }
 }
@@ -117,8 +120,8 @@ void RegisterFeaturesCommand(CLI::App& app) {
   auto options = std::make_shared<FeaturesOptions>();
   CLI::App* command = app.add_subcommand(
       "features",
-      "Extract FLIRT keypoints (curvature detector + beta-grid descriptor, FLIRTLib defaults) "
-      "from the scans of a log and print statistics.");
+      "Extract FLIRT keypoints (curvature detector + beta-grid descriptor, FLIRTLib defaults; "
+      "--set features.KEY=VALUE changes them) from the scans of a log and print statistics.");
   command->add_option("input", options->input, "CARMEN log (.log or .log.gz)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -130,6 +133,7 @@ void RegisterFeaturesCommand(CLI::App& app) {
                       "Write one keypoint a line: scan, x, y, orientation, scale (laser frame; "
                       "m, rad; scale = 2 sigma of the detection level)");
   command->add_option("--json", options->json_path, "Write the statistics as JSON to FILE");
+  AddConfigOptions(command, options->config);
   command->callback([options] { RunFeatures(*options); });
 }
 

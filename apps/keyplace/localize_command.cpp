@@ -41,6 +41,7 @@ struct LocalizeOptions {
   std::optional<double> gamma_min;
   std::optional<double> lambda;
   std::optional<double> min_confidence;
+  std::string descriptor_index;
   int n_pos = 500;
   bool exclude_shared_scans = false;
   bool skip_bad_lines = false;
@@ -57,6 +58,9 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
   if (o.lambda) aliases.push_back(fmt::format("place.double_match_m={}", *o.lambda));
   if (o.min_confidence)
     aliases.push_back(fmt::format("place.min_confidence={}", *o.min_confidence));
+  if (!o.descriptor_index.empty()) {
+    aliases.push_back(fmt::format("place.descriptor_index={}", o.descriptor_index));
+  }
   return aliases;
 }
 
@@ -186,6 +190,11 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--lambda", options->lambda, "Alias of --set place.double_match_m=M");
   command->add_option("--min-confidence", options->min_confidence,
                       "Alias of --set place.min_confidence=C (0..1)");
+  command
+      ->add_option("--descriptor-index", options->descriptor_index,
+                   "Alias of --set place.descriptor_index=X: dense (default), kdtree or none "
+                   "(exhaustive; all find the same pairs)")
+      ->check(CLI::IsMember({"dense", "kdtree", "none"}));
   AddConfigOptions(command, options->config);
   command->add_option("--n-pos", options->n_pos, "Number of queries")->capture_default_str();
   command->add_flag("--exclude-shared-scans", options->exclude_shared_scans,

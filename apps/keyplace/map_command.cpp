@@ -1,9 +1,7 @@
 // keyplace map LOG: build the global map of stable keypoints (paper Algorithms 1-2).
 
 #include <chrono>
-#include <filesystem>
 #include <memory>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -13,7 +11,6 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
-#include "io/file_fingerprint.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
@@ -36,6 +33,93 @@ struct MapOptions {
   bool skip_bad_lines = false;
 };
 
+// Table II was measured with the overlap criterion alone, Table VI with all criteria.
+const PaperMappingRow* PaperRow(const std::string& log_path, bool overlap_only) {
+  const auto dataset = DatasetName(log_path);
+  const PaperMappingRow* paper = dataset ? PaperMapping(*dataset) : nullptr;
+  if (paper != nullptr && (std::string(paper->table) == "II") != overlap_only) return nullptr;
+  return paper;
+}
+
+void PrintMapReport(const MapOptions& options, const LogInputs& inputs, const LogMap& result) {
+  const MappingStats& stats = result.stats;
+  const std::size_t scans = inputs.log.scans.size();
+  const std::size_t covered =
+      result.map.submaps.empty() ? 0 : result.map.submaps.back().last_scan() + 1;
+  fmt::print("log                  {} ({} scans, {} poses)\n", options.input, scans,
+             ToString(inputs.pose_source));
+  fmt::print("submaps              {} ({} forced by the scan or grid limit), scans 0..{} of {}\n",
+             stats.submaps, stats.forced_submaps, covered, scans);
+  fmt::print("scans per submap     {:.2f}\n", stats.scans_per_submap);
+  fmt::print("keypoints per submap {:.2f}\n", stats.keypoints_per_submap);
+  fmt::print("compression          {:.3f} ({} stable of {} keypoints: {:.1f} % less map data)\n",
+             stats.compression, stats.stable_keypoints, stats.source_keypoints,
+             100.0 * (1.0 - stats.compression));
+  fmt::print("distribution         {:.3f}\n", stats.distribution);
+  fmt::print("time per submap      {:.4f} s mapping, {:.4f} s with poses and keypoints\n",
+             result.seconds_per_submap_mapping, result.seconds_per_submap);
+  fmt::print(
+      "time                 read {:.2f} s, poses {:.2f} s, keypoints {:.2f} s, mapping "
+      "{:.2f} s\n",
+      inputs.seconds_read, inputs.seconds_poses, inputs.seconds_keypoints,
+      result.timings.seconds_total);
+  if (const PaperMappingRow* paper = PaperRow(options.input, options.overlap_only)) {
+    fmt::print("\nTable {} ({})   {:>8} {:>8} {:>10} {:>8} {:>8} {:>9}\n", paper->table,
+               *DatasetName(options.input), "Compress", "#Scans", "#Keypoints", "Distrib",
+               "#Submaps", "Time (s)");
+    fmt::print("  paper          {:8.2f} {:8.2f} {:10.2f} {:8.2f} {:8d} {:9.3f}\n",
+               paper->compression, paper->scans_per_submap, paper->keypoints_per_submap,
+               paper->distribution, paper->submaps, paper->seconds_per_submap);
+    fmt::print("  keyplace       {:8.2f} {:8.2f} {:10.2f} {:8.2f} {:8d} {:9.3f}\n",
+               stats.compression, stats.scans_per_submap, stats.keypoints_per_submap,
+               stats.distribution, static_cast<int>(stats.submaps), result.seconds_per_submap);
+  }
+  if (!options.out_path.empty()) fmt::print("\nmap written to {}\n", options.out_path);
+}
+
+void DrawFigures(const MapOptions& options, const LogInputs& inputs, const LogMap& result) {
+  MapFigureOptions figure;
+  figure.title = fmt::format("{}: {} submaps, {} stable keypoints ({} poses)",
+                             result.map.source_log, result.stats.submaps,
+                             result.stats.stable_keypoints, ToString(inputs.pose_source));
+  for (const std::string& path : {options.png_path, options.svg_path}) {
+    if (!path.empty()) DrawMapFigure(path, result.map, inputs.log.scans, inputs.poses, figure);
+  }
+}
+
+nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const LogMap& result) {
+  const MappingStats& stats = result.stats;
+  const auto dataset = DatasetName(options.input);
+  nlohmann::json json;
+  json["log"] = options.input;
+  json["dataset"] = dataset ? *dataset : "";
+  json["pose_source"] = ToString(inputs.pose_source);
+  json["scans"] = inputs.log.scans.size();
+  json["compression"] = stats.compression;
+  json["scans_per_submap"] = stats.scans_per_submap;
+  json["keypoints_per_submap"] = stats.keypoints_per_submap;
+  json["distribution"] = stats.distribution;
+  json["submaps"] = stats.submaps;
+  json["forced_submaps"] = stats.forced_submaps;
+  json["stable_keypoints"] = stats.stable_keypoints;
+  json["source_keypoints"] = stats.source_keypoints;
+  json["seconds_per_submap"] = result.seconds_per_submap;
+  json["seconds_per_submap_mapping_only"] = result.seconds_per_submap_mapping;
+  json["seconds_poses"] = inputs.seconds_poses;
+  json["seconds_keypoints"] = inputs.seconds_keypoints;
+  json["seconds_mapping"] = result.timings.seconds_total;
+  if (const PaperMappingRow* paper = PaperRow(options.input, options.overlap_only)) {
+    json["paper"] = {{"table", paper->table},
+                     {"compression", paper->compression},
+                     {"scans_per_submap", paper->scans_per_submap},
+                     {"keypoints_per_submap", paper->keypoints_per_submap},
+                     {"distribution", paper->distribution},
+                     {"submaps", paper->submaps},
+                     {"seconds_per_submap", paper->seconds_per_submap}};
+  }
+  return json;
+}
+
 void RunMap(const MapOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const Config config = ResolveConfig(options.config, [&](Config& c) {
@@ -51,113 +135,17 @@ void RunMap(const MapOptions& options) {
   input_options.features = config.features;
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
   PrintLogWarnings(inputs.log);
-  const CarmenLog& log = inputs.log;
-  const PoseSource source = inputs.pose_source;
-  const double read_seconds = inputs.seconds_read;
-  const double pose_seconds = inputs.seconds_poses;
-  const double keypoint_seconds = inputs.seconds_keypoints;
-
-  Progress map_progress("mapping", log.scans.size());
-  GlobalMappingTimings timings;
-  GlobalMap map =
-      BuildGlobalMap({log.scans, inputs.poses, inputs.keypoints}, config.mapping, &timings,
-                     [&](std::size_t next_scan) { map_progress.Update(next_scan); });
-  map_progress.Finish();
-  map.source_log = inputs.source_log;
-  map.source_hash = inputs.source_hash;
-  map.pose_source = ToString(source);
-  map.configuration = ConfigToYaml(config);
-  const MappingStats stats = ComputeStats(map);
-  const double seconds_per_submap =
-      timings.submap_seconds.empty()
-          ? 0.0
-          : std::accumulate(timings.submap_seconds.begin(), timings.submap_seconds.end(), 0.0) /
-                static_cast<double>(timings.submap_seconds.size());
-  // Per submap including its share of pose estimation and keypoint extraction.
-  const double seconds_per_submap_all =
-      stats.submaps > 0 ? seconds_per_submap +
-                              (pose_seconds + keypoint_seconds) / static_cast<double>(stats.submaps)
-                        : 0.0;
-
-  if (!options.out_path.empty()) SaveMap(map, options.out_path);
-  const std::size_t covered_scans = map.submaps.empty() ? 0 : map.submaps.back().last_scan() + 1;
-
-  fmt::print("log                  {} ({} scans, {} poses)\n", options.input, log.scans.size(),
-             ToString(source));
-  fmt::print("submaps              {} ({} forced by the scan or grid limit), scans 0..{} of {}\n",
-             stats.submaps, stats.forced_submaps, covered_scans, log.scans.size());
-  fmt::print("scans per submap     {:.2f}\n", stats.scans_per_submap);
-  fmt::print("keypoints per submap {:.2f}\n", stats.keypoints_per_submap);
-  fmt::print("compression          {:.3f} ({} stable of {} keypoints: {:.1f} % less map data)\n",
-             stats.compression, stats.stable_keypoints, stats.source_keypoints,
-             100.0 * (1.0 - stats.compression));
-  fmt::print("distribution         {:.3f}\n", stats.distribution);
-  fmt::print("time per submap      {:.4f} s mapping, {:.4f} s with poses and keypoints\n",
-             seconds_per_submap, seconds_per_submap_all);
-  fmt::print(
-      "time                 read {:.2f} s, poses {:.2f} s, keypoints {:.2f} s, mapping "
-      "{:.2f} s\n",
-      read_seconds, pose_seconds, keypoint_seconds, timings.seconds_total);
-  const auto dataset = DatasetName(options.input);
-  // Table II was measured with the overlap criterion alone, Table VI with all criteria.
-  const PaperMappingRow* paper = dataset ? PaperMapping(*dataset) : nullptr;
-  if (paper != nullptr && (std::string(paper->table) == "II") != options.overlap_only) {
-    paper = nullptr;
-  }
-  if (paper) {
-    fmt::print("\nTable {} ({})   {:>8} {:>8} {:>10} {:>8} {:>8} {:>9}\n", paper->table, *dataset,
-               "Compress", "#Scans", "#Keypoints", "Distrib", "#Submaps", "Time (s)");
-    fmt::print("  paper          {:8.2f} {:8.2f} {:10.2f} {:8.2f} {:8d} {:9.3f}\n",
-               paper->compression, paper->scans_per_submap, paper->keypoints_per_submap,
-               paper->distribution, paper->submaps, paper->seconds_per_submap);
-    fmt::print("  keyplace       {:8.2f} {:8.2f} {:10.2f} {:8.2f} {:8d} {:9.3f}\n",
-               stats.compression, stats.scans_per_submap, stats.keypoints_per_submap,
-               stats.distribution, static_cast<int>(stats.submaps), seconds_per_submap_all);
-  }
-  if (!options.out_path.empty()) fmt::print("\nmap written to {}\n", options.out_path);
-
-  if (!options.png_path.empty() || !options.svg_path.empty()) {
-    MapFigureOptions figure;
-    figure.title = fmt::format("{}: {} submaps, {} stable keypoints ({} poses)", map.source_log,
-                               stats.submaps, stats.stable_keypoints, ToString(source));
-    if (!options.png_path.empty()) {
-      DrawMapFigure(options.png_path, map, log.scans, inputs.poses, figure);
-    }
-    if (!options.svg_path.empty()) {
-      DrawMapFigure(options.svg_path, map, log.scans, inputs.poses, figure);
-    }
-  }
-
+  Progress progress("mapping", inputs.log.scans.size());
+  LogMap result = MapLog(inputs, config.mapping, [&](std::size_t next) { progress.Update(next); });
+  progress.Finish();
+  result.map.configuration = ConfigToYaml(config);
+  if (!options.out_path.empty()) SaveMap(result.map, options.out_path);
+  PrintMapReport(options, inputs, result);
+  DrawFigures(options, inputs, result);
   if (!options.json_path.empty()) {
-    nlohmann::json json;
-    json["log"] = options.input;
-    json["dataset"] = dataset ? *dataset : "";
-    json["pose_source"] = ToString(source);
-    json["scans"] = log.scans.size();
-    json["compression"] = stats.compression;
-    json["scans_per_submap"] = stats.scans_per_submap;
-    json["keypoints_per_submap"] = stats.keypoints_per_submap;
-    json["distribution"] = stats.distribution;
-    json["submaps"] = stats.submaps;
-    json["forced_submaps"] = stats.forced_submaps;
-    json["stable_keypoints"] = stats.stable_keypoints;
-    json["source_keypoints"] = stats.source_keypoints;
-    json["seconds_per_submap"] = seconds_per_submap_all;
-    json["seconds_per_submap_mapping_only"] = seconds_per_submap;
+    nlohmann::json json = MapJson(options, inputs, result);
     json["seconds_total"] = SecondsSince(start);
-    json["seconds_poses"] = pose_seconds;
-    json["seconds_keypoints"] = keypoint_seconds;
-    json["seconds_mapping"] = timings.seconds_total;
     json["config"] = ConfigJson(config);
-    if (paper) {
-      json["paper"] = {{"table", paper->table},
-                       {"compression", paper->compression},
-                       {"scans_per_submap", paper->scans_per_submap},
-                       {"keypoints_per_submap", paper->keypoints_per_submap},
-                       {"distribution", paper->distribution},
-                       {"submaps", paper->submaps},
-                       {"seconds_per_submap", paper->seconds_per_submap}};
-    }
     WriteJson(options.json_path, json);
   }
 }

@@ -13,15 +13,8 @@
 namespace keyplace::cli {
 
 std::vector<double> MappingSweepRow(const LogInputs& inputs, const MappingConfig& config) {
-  GlobalMappingTimings timings;
-  const GlobalMap map =
-      BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, config, &timings);
-  const MappingStats stats = ComputeStats(map);
-  double seconds = 0.0;
-  for (const double s : timings.submap_seconds) seconds += s;
-  const double per_submap = timings.submap_seconds.empty()
-                                ? 0.0
-                                : seconds / static_cast<double>(timings.submap_seconds.size());
+  const LogMap result = MapLog(inputs, config);
+  const MappingStats& stats = result.stats;
   return {static_cast<double>(stats.submaps),
           static_cast<double>(stats.forced_submaps),
           stats.compression,
@@ -29,7 +22,7 @@ std::vector<double> MappingSweepRow(const LogInputs& inputs, const MappingConfig
           stats.distribution,
           stats.keypoints_per_submap,
           static_cast<double>(stats.stable_keypoints),
-          per_submap};
+          result.seconds_per_submap_mapping};
 }
 
 PlaceSweepSetting PreparePlaceSweepSetting(const LogInputs& inputs, const MappingConfig& mapping,

@@ -42,6 +42,7 @@ std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos) {
   }
   if (eligible.empty()) throw std::invalid_argument("no query scan has a ground-truth pose");
   std::vector<int> starts;
+  starts.reserve(static_cast<std::size_t>(n_pos));
   for (int i = 0; i < n_pos; ++i) {
     starts.push_back(
         eligible[static_cast<std::size_t>(i) * eligible.size() / static_cast<std::size_t>(n_pos)]);

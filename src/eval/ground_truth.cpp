@@ -44,11 +44,12 @@ GroundTruth TruthFromIndex(const CarmenLog& log, std::size_t first_scan, std::si
   truth.truth_index_of_scan.assign(log.scans.size(), -1);
   for (const IndexPair& pair : ReadIndexPairs(index_path)) {
     if (pair.raw_index >= file_scans || pair.corrected_index >= truth.truth_poses.size()) {
-      throw std::invalid_argument(index_path + ": pair " + std::to_string(pair.raw_index) + " -> " +
-                                  std::to_string(pair.corrected_index) + " lies outside " +
-                                  log.path + " (" + std::to_string(file_scans) + " scans) or " +
-                                  truth_path + " (" + std::to_string(truth.truth_poses.size()) +
-                                  " scans)");
+      std::string message = index_path;
+      message += ": pair " + std::to_string(pair.raw_index);
+      message += " -> " + std::to_string(pair.corrected_index);
+      message += " lies outside " + log.path + " (" + std::to_string(file_scans) + " scans)";
+      message += " or " + truth_path + " (" + std::to_string(truth.truth_poses.size()) + " scans)";
+      throw std::invalid_argument(message);
     }
     if (pair.raw_index < first_scan || pair.raw_index - first_scan >= log.scans.size()) continue;
     const std::size_t scan = pair.raw_index - first_scan;

@@ -106,12 +106,14 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   start = std::chrono::steady_clock::now();
   inputs.pose_source =
       options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected : PoseSource::kIcp);
-  const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
-  inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
-                           [&](std::size_t done, std::size_t total) {
-                             if (progress) progress(pose_stage, done, total);
-                           });
-  inputs.seconds_poses = SecondsSince(start);
+  if (options.compute_poses) {
+    const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
+    inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
+                             [&](std::size_t done, std::size_t total) {
+                               if (progress) progress(pose_stage, done, total);
+                             });
+    inputs.seconds_poses = SecondsSince(start);
+  }
 
   if (options.keypoints) {
     start = std::chrono::steady_clock::now();
@@ -123,6 +125,29 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
     inputs.seconds_keypoints = SecondsSince(start);
   }
   return inputs;
+}
+
+LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
+              const std::function<void(std::size_t)>& progress) {
+  LogMap result;
+  result.map = BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, config,
+                              &result.timings, progress);
+  result.map.source_log = inputs.source_log;
+  result.map.source_hash = inputs.source_hash;
+  result.map.pose_source = ToString(inputs.pose_source);
+  result.stats = ComputeStats(result.map);
+  const std::vector<double>& seconds = result.timings.submap_seconds;
+  if (!seconds.empty()) {
+    double sum = 0.0;
+    for (const double s : seconds) sum += s;
+    result.seconds_per_submap_mapping = sum / static_cast<double>(seconds.size());
+  }
+  if (result.stats.submaps > 0) {
+    result.seconds_per_submap =
+        result.seconds_per_submap_mapping + (inputs.seconds_poses + inputs.seconds_keypoints) /
+                                                static_cast<double>(result.stats.submaps);
+  }
+  return result;
 }
 
 }  // namespace keyplace

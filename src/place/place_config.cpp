@@ -47,6 +47,12 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
               {{C::PairMatching::kQueryOrder, "query_order"},
                {C::PairMatching::kGlobalGreedy, "global_greedy"}},
               "how unique pairs are chosen: query order (Algorithm 3) or globally by distance")
+        .Enum("descriptor_index", &C::descriptor_index,
+              {{C::DescriptorIndex::kNone, "none"},
+               {C::DescriptorIndex::kKdTree, "kdtree"},
+               {C::DescriptorIndex::kDense, "dense"}},
+              "how descriptor pairs are found (same pairs): exhaustive chi2 (none), or a "
+              "square-root bound searched by a kd-tree (kdtree) or a matrix product (dense)")
         .Enum("query_keypoints", &C::query_keypoints,
               {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}},
               "query keypoints paired and verified: the submap's stable ones or all its scans'")

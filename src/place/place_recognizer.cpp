@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "keyplace/place/ransac.hpp"
+#include "place/descriptor_index.hpp"
 
 namespace keyplace {
 namespace {
@@ -99,28 +100,21 @@ std::vector<Place> PlacesFromMap(const GlobalMap& map) {
   return places;
 }
 
-std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescriptor>& current,
-                                                 const std::vector<BetaGridDescriptor>& reference,
-                                                 double chi2_threshold,
-                                                 PlaceRecognitionConfig::PairMatching mode) {
-  // Every pair below the threshold, with its distance.
-  std::vector<DescriptorPair> below;
-  for (std::size_t c = 0; c < current.size(); ++c) {
-    for (std::size_t r = 0; r < reference.size(); ++r) {
-      if (SymmetricChi2Below(current[c], reference[r], chi2_threshold)) {
-        below.push_back(
-            {static_cast<int>(c), static_cast<int>(r), SymmetricChi2(current[c], reference[r])});
-      }
-    }
-  }
+namespace {
+
+// The unique pairs (Algorithm 3's FindUniqueMatch) among `below`: every pair below the threshold
+// with its distance, ordered by current index, then reference index.
+std::vector<DescriptorPair> UniquePairs(std::vector<DescriptorPair> below, std::size_t n_current,
+                                        std::size_t n_reference,
+                                        PlaceRecognitionConfig::PairMatching mode) {
   if (mode == PlaceRecognitionConfig::PairMatching::kGlobalGreedy) {
     std::stable_sort(
         below.begin(), below.end(),
         [](const DescriptorPair& a, const DescriptorPair& b) { return a.distance < b.distance; });
   }
   // kQueryOrder: `below` is ordered by current keypoint; each takes its nearest unused reference.
-  std::vector<char> current_used(current.size(), 0);
-  std::vector<char> reference_used(reference.size(), 0);
+  std::vector<char> current_used(n_current, 0);
+  std::vector<char> reference_used(n_reference, 0);
   std::vector<DescriptorPair> pairs;
   if (mode == PlaceRecognitionConfig::PairMatching::kGlobalGreedy) {
     for (const DescriptorPair& pair : below) {
@@ -149,6 +143,25 @@ std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescr
     begin = end;
   }
   return pairs;
+}
+
+}  // namespace
+
+std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescriptor>& current,
+                                                 const std::vector<BetaGridDescriptor>& reference,
+                                                 double chi2_threshold,
+                                                 PlaceRecognitionConfig::PairMatching mode) {
+  // Every pair below the threshold, with its distance.
+  std::vector<DescriptorPair> below;
+  for (std::size_t c = 0; c < current.size(); ++c) {
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+      if (SymmetricChi2Below(current[c], reference[r], chi2_threshold)) {
+        below.push_back(
+            {static_cast<int>(c), static_cast<int>(r), SymmetricChi2(current[c], reference[r])});
+      }
+    }
+  }
+  return UniquePairs(std::move(below), current.size(), reference.size(), mode);
 }
 
 GammaResult ComputeGamma(const std::vector<Eigen::Vector2d>& reference_positions,
@@ -279,6 +292,9 @@ PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecogniti
                                   ": positions and descriptors differ in size");
     }
   }
+  if (config_.descriptor_index != PlaceRecognitionConfig::DescriptorIndex::kNone) {
+    index_ = std::make_shared<const SqrtDescriptorIndex>(places_, config_.descriptor_index);
+  }
 }
 
 PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
@@ -319,6 +335,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   };
   std::vector<Candidate> candidates;
   if (match_positions->size() >= min_pairs) {
+    std::vector<char> searched(places_.size(), 0);
     for (std::size_t p = 0; p < places_.size(); ++p) {
       const Place& place = places_[p];
       if (place.positions.size() < min_pairs) continue;  // can never reach mu pairs
@@ -326,9 +343,22 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
         ++match.places_excluded;
         continue;
       }
+      searched[p] = 1;
+    }
+    // The index finds, per place, the pairs below the threshold that the exhaustive loop of
+    // MatchDescriptorPairs finds, in its order and with its distances.
+    std::vector<std::vector<DescriptorPair>> below;
+    if (index_) {
+      index_->FindPairs(*match_descriptors, config_.descriptor_match_chi2, searched, below);
+    }
+    for (std::size_t p = 0; p < places_.size(); ++p) {
+      if (!searched[p]) continue;
+      const Place& place = places_[p];
       std::vector<DescriptorPair> pairs =
-          MatchDescriptorPairs(*match_descriptors, place.descriptors, config_.descriptor_match_chi2,
-                               config_.pair_matching);
+          index_ ? UniquePairs(std::move(below[p]), match_descriptors->size(),
+                               place.descriptors.size(), config_.pair_matching)
+                 : MatchDescriptorPairs(*match_descriptors, place.descriptors,
+                                        config_.descriptor_match_chi2, config_.pair_matching);
       if (pairs.size() < min_pairs) continue;
       double sum = 0.0;
       for (const DescriptorPair& pair : pairs) sum += pair.distance;

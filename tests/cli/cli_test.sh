@@ -31,6 +31,30 @@ import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['keypoints_per_scan_mean'] > 5 and j['seconds_per_scan_mean'] > 0" "$work/kp.json"
 
+check "features --set" "$keyplace" features "$log" --scans 0:5 --set features.num_scales=3 \
+  --json "$work/kp3.json"
+check "features --set json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert len(j['keypoints_per_level']) == 3 and j['config']['features']['num_scales'] == '3', j" \
+  "$work/kp3.json"
+
+# The bundled log is corrected (no odometry poses): ICP starts from zero motion.
+check "odometry" "$keyplace" odometry "$log" --scans 0:100 --set odometry.icp.kernel=huber \
+  --local-dt 2 --out "$work/odo.tsv" --json "$work/odo.json"
+check "odometry json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert j['scans'] == 100 and j['scans_in_log'] == 1464 and j['missing_odometry'] == 100, j
+assert j['registered'] + j['not_converged'] + j['fallback_correction_too_large'] \
+    + j['fallback_too_few_points'] == 99, j
+c=j['config']
+assert c['odometry']['icp']['kernel'] == 'huber', c['odometry']
+assert float(c['evaluation']['local_relation_max_dt_s']) == 2, c['evaluation']" "$work/odo.json"
+check "odometry tsv rows" test "$(($(wc -l <"$work/odo.tsv") - 1))" = 100
+fails_with "bad odometry --set value" "odometry.icp.kernel" "$keyplace" odometry "$log" \
+  --set odometry.icp.kernel=gauss
+
 check "map" "$keyplace" map "$log" --out "$work/map.kpm" --json "$work/map.json" --png "$work/map.png"
 check "map json keys" python3 -c "
 import json,sys

@@ -49,6 +49,9 @@ j = json.load(open(sys.argv[1]))
 assert j['precision_overlap_30_common_area'] == 1.0, j['precision_overlap_30_common_area']
 assert j['ate_rmse_m'] < j['ate_icp_rmse_m'], (j['ate_rmse_m'], j['ate_icp_rmse_m'])
 assert j['relations']['translation_mean_m'] < 0.1, j['relations']
+# The whole configuration is recorded (section -> key -> value), defaults here.
+assert j['config']['slam']['gate_base_m'] == '2', j['config']['slam']
+assert j['config']['evaluation']['truth_max_gap_scans'] == '50', j['config']['evaluation']
 " "$work/slam.json"
 for figure in trajectory overlap_histogram overlap_histogram_common_area rpe ate; do
   check "figure $figure" test -s "$work/figures/$figure.png"
@@ -64,5 +67,8 @@ check "json kept" cmp "$work/slam.json" "$work/slam.before.json"
 fails_with "truth without index" "--index" "$keyplace" slam "$raw" \
   --truth "$shared/data/fr079-corrected.log.gz"
 fails_with "missing log" "no-such.log" "$keyplace" slam "$work/no-such.log"
+# Tuning goes through --set section.key=value; unknown keys and the old flags are errors.
+fails_with "bad --set key" "no_such" "$keyplace" slam "$raw" --set slam.no_such=1
+fails_with "removed flag" "--no-gate" "$keyplace" slam "$raw" --no-gate
 
 finish "slam_test"

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "keyplace/io/carmen_log.hpp"
 #include "synthetic_scene.hpp"
 
 namespace keyplace {
@@ -38,7 +39,8 @@ Drive MakeDrive(const std::vector<testing::Segment>& world, int steps, const Pos
       odometry = odometry * Pose2(step_motion.x * 1.05, step_motion.y * 1.05,
                                   step_motion.theta + DegToRad(0.5));
     }
-    LogScan scan{CastScan(world, truth * T_robot_laser, options, &rng)};
+    LogScan scan;
+    static_cast<LaserScan&>(scan) = CastScan(world, truth * T_robot_laser, options, &rng);
     scan.T_robot_laser = T_robot_laser;
     scan.odometry_pose = odometry;
     scan.timestamp_s = 100.0 + 0.1 * i;

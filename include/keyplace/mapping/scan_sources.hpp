@@ -11,6 +11,8 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
 
 namespace keyplace {
@@ -51,6 +53,8 @@ struct LogInputOptions {
   std::size_t first_scan = 0;
   std::size_t end_scan = static_cast<std::size_t>(-1);
   bool keypoints = true;  // false: leave LogInputs::keypoints empty
+  // false: leave LogInputs::poses empty, for callers that estimate the poses themselves (SLAM)
+  bool compute_poses = true;
 };
 
 /// Progress of a preparation stage ("poses (icp)", "keypoints"): (stage, done, total).
@@ -61,7 +65,7 @@ using StageProgress = std::function<void(const std::string&, std::size_t, std::s
 struct LogInputs {
   CarmenLog log;  // scans cut to the requested range; log.warnings: damage the reader skipped
   PoseSource pose_source = PoseSource::kCorrected;
-  std::vector<Pose2> poses;                      // T_world_robot of every scan
+  std::vector<Pose2> poses;                      // T_world_robot of every scan (if computed)
   std::vector<std::vector<Keypoint>> keypoints;  // laser frame
   std::string source_log;                        // file name of the log
   std::string source_hash;                       // FileFingerprint of the log
@@ -76,5 +80,19 @@ struct LogInputs {
 /// computes the poses and the keypoints. `progress` may be empty.
 LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options = {},
                            const StageProgress& progress = {});
+
+/// A log's global map (Algorithm 2) with its provenance and the mapping criteria of Section 5.1.
+struct LogMap {
+  GlobalMap map;  // source_log, source_hash, pose_source set from the inputs
+  MappingStats stats;
+  GlobalMappingTimings timings;
+  double seconds_per_submap_mapping = 0.0;  // mean time to build a submap (keypoints given)
+  // ... plus each submap's share of the pose estimation and keypoint extraction.
+  double seconds_per_submap = 0.0;
+};
+
+/// Builds the map of `inputs` with `config`; `progress` (may be empty) gets the next scan index.
+LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
+              const std::function<void(std::size_t)>& progress = {});
 
 }  // namespace keyplace

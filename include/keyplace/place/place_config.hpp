@@ -22,6 +22,14 @@ struct PlaceRecognitionConfig {
   // literally). kGlobalGreedy: all pairs below the threshold by increasing distance.
   enum class PairMatching { kQueryOrder, kGlobalGreedy };
   PairMatching pair_matching = PairMatching::kGlobalGreedy;
+  // How the pairs below descriptor_match_chi2 are found; every choice finds exactly the same pairs
+  // (docs/PLACE.md, "Descriptor index"). kNone: every query keypoint against every place keypoint
+  // (the oracle). kKdTree, kDense: ||sqrt(x) - sqrt(y)||^2 <= 2 chi2_sym(x, y), so only the place
+  // keypoints within a radius^2 of 2 * descriptor_match_chi2 of the query keypoint in square-root
+  // space get the exact chi2 test; kKdTree finds them by a nanoflann kd-tree, kDense by one
+  // matrix product of the query keypoints with all place keypoints.
+  enum class DescriptorIndex { kNone, kKdTree, kDense };
+  DescriptorIndex descriptor_index = DescriptorIndex::kDense;
   // Which query keypoints go through pairing and RANSAC. kStable: the query submap's stable
   // keypoints (the paper). kAllScans: every keypoint of every scan of the query submap, in the
   // submap frame (PlaceQuery::all_positions), merged within query_merge_m; falls back to the

@@ -3,9 +3,11 @@
 // RANSAC pose estimation (Eq. 9), first (consensus) and second (gamma, Eq. 10) geometric
 // verification. A "place" is a set of keypoints in its own frame with the world pose of that
 // frame: a submap of a GlobalMap, or a single scan (the TIP-FLIRT baseline), on the same code.
-// Matching is exhaustive over all places: the oracle for any faster index.
+// Descriptor pairs come from an exact index over all place keypoints (descriptor_index), or from
+// exhaustive matching (descriptor_index none): the oracle, with the same pairs.
 
 #include <functional>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -57,7 +59,8 @@ struct DescriptorPair {
   double distance = 0.0;
 };
 
-/// Unique descriptor pairs below `chi2_threshold` (each keypoint used at most once).
+/// Unique descriptor pairs below `chi2_threshold` (each keypoint used at most once), by comparing
+/// every current with every reference descriptor.
 std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescriptor>& current,
                                                  const std::vector<BetaGridDescriptor>& reference,
                                                  double chi2_threshold,
@@ -133,6 +136,8 @@ struct PlaceMatch {
 /// Returns true for places the query must not be matched with (self-matches).
 using PlaceExclusion = std::function<bool(const Place&)>;
 
+class SqrtDescriptorIndex;  // place/descriptor_index.hpp (internal)
+
 class PlaceRecognizer {
  public:
   /// Throws std::invalid_argument (Validate) for an invalid config.
@@ -146,6 +151,7 @@ class PlaceRecognizer {
  private:
   std::vector<Place> places_;
   PlaceRecognitionConfig config_;
+  std::shared_ptr<const SqrtDescriptorIndex> index_;  // null for descriptor_index none
 };
 
 }  // namespace keyplace

@@ -1,0 +1,182 @@
+// The JSON of figures and the loops / trajectory TSVs of `keyplace slam`.
+
+#include <cmath>
+#include <ostream>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "config_options.hpp"
+#include "eval_json.hpp"
+#include "io/atomic_file.hpp"
+#include "paper_tables.hpp"
+#include "slam_output.hpp"
+
+namespace keyplace::cli {
+namespace {
+
+double Deg(double rad) { return rad * 180.0 / M_PI; }
+
+void AddLoopJson(const SlamReport& r, nlohmann::json& json) {
+  const SlamStats& s = r.run.slam->stats();
+  const SlamEvaluation& e = r.evaluation;
+  const LoopPrecisions& p = e.precision;
+  json["queries"] = s.queries;
+  json["loops_detected"] = r.run.slam->loops().size();
+  json["loops_accepted"] = s.loops_accepted;
+  json["loops_used"] = e.loops.used_count;
+  json["loops_refined"] = s.loops_refined;
+  json["loops_partner_changed"] = s.loops_partner_changed;
+  json["loops_rejected_by_point_overlap"] = s.loops_rejected_by_point_overlap;
+  json["precision_overlap_30_matched_ransac"] = p.matched_ransac_30;
+  json["optimizations"] = s.optimizations;
+  json["ceres_solves"] = s.solves;
+  json["precision_overlap_10"] = p.overlap_10;
+  json["precision_overlap_30"] = p.overlap_30;
+  json["precision_overlap_30_used"] = p.used_overlap_30;
+  json["precision_overlap_30_cells_0_2m"] = p.cells_0_2m_30;
+  json["precision_overlap_10_cells_0_2m"] = p.cells_0_2m_10;
+  json["loops_below_1_percent_overlap"] = e.loops_below_1_percent;
+  json["precision_overlap_10_common_area"] = p.common_area_10;
+  json["precision_overlap_30_common_area"] = p.common_area_30;
+  json["overlap_histogram_common_area"] = e.histogram_common.counts;
+  json["overlap_histogram"] = e.histogram.counts;
+}
+
+void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
+  const LoopEvaluation& ev = e.loops;
+  json["loops_truth_evaluated"] = ev.truth_evaluated;
+  json["loops_truth_correct"] = ev.truth_correct;
+  json["loops_truth_max_gap_scans"] = e.truth_max_gap_scans;
+  nlohmann::json tests = nlohmann::json::array();
+  for (const OverlapTest& t : ev.overlap_tests) {
+    tests.push_back({{"threshold", t.threshold},
+                     {"correct", ev.truth_correct},
+                     {"wrong", ev.truth_wrong},
+                     {"all_cells_correct_passed", t.all_cells_correct},
+                     {"all_cells_wrong_passed", t.all_cells_wrong},
+                     {"common_area_correct_passed", t.common_correct},
+                     {"common_area_wrong_passed", t.common_wrong}});
+  }
+  json["overlap_vs_truth"] = tests;
+  json["loop_truth_error"] = {{"loops", ev.paired_loops},
+                              {"translation_mean_m", ev.paired_final_m},
+                              {"rotation_mean_deg", ev.paired_final_deg},
+                              {"ransac_translation_mean_m", ev.paired_ransac_m},
+                              {"ransac_rotation_mean_deg", ev.paired_ransac_deg}};
+  json["precision_truth"] = ev.precision_truth();
+}
+
+void AddMapAndTimeJson(const SlamReport& r, double total_seconds, nlohmann::json& json) {
+  const MappingStats& m = r.evaluation.mapping;
+  const SlamStats& s = r.run.slam->stats();
+  json["submaps"] = m.submaps;
+  json["compression"] = m.compression;
+  json["scans_per_submap"] = m.scans_per_submap;
+  json["keypoints_per_submap"] = m.keypoints_per_submap;
+  json["distribution"] = m.distribution;
+  json["forced_submaps"] = m.forced_submaps;
+  json["seconds_per_submap"] = r.evaluation.seconds_per_submap;
+  json["seconds"] = {
+      {"keypoints", r.run.seconds_keypoints},   {"slam", r.run.seconds_slam},
+      {"odometry", s.seconds_odometry},         {"mapping", s.seconds_mapping},
+      {"recognition", s.seconds_recognition},   {"loop_refinement", s.seconds_loop_refinement},
+      {"optimization", s.seconds_optimization}, {"total", total_seconds}};
+}
+
+nlohmann::json PaperJson(const PaperSlamRow& paper) {
+  return {{"compression", paper.compression},
+          {"scans_per_submap", paper.scans_per_submap},
+          {"keypoints_per_submap", paper.keypoints_per_submap},
+          {"distribution", paper.distribution},
+          {"submaps", paper.submaps},
+          {"seconds_per_submap", paper.seconds_per_submap},
+          {"loops_detected", paper.loops_detected},
+          {"loops_used", paper.loops_used},
+          {"precision_overlap_30", paper.precision_overlap_30},
+          {"precision_overlap_10", paper.precision_overlap_10}};
+}
+
+void AddAccuracyJson(const SlamAccuracy& a, nlohmann::json& json) {
+  json["ate_rmse_m"] = a.ate.translation_rmse_m;
+  json["ate_rotation_rmse_deg"] = a.ate.rotation_rmse_deg;
+  json["ate_icp_rmse_m"] = a.ate_icp.translation_rmse_m;
+  json["ate_icp_rotation_rmse_deg"] = a.ate_icp.rotation_rmse_deg;
+  json["truth_pairs"] = a.truth_pairs;
+  nlohmann::json rpe = nlohmann::json::array();
+  for (const RpePoint& p : a.rpe) {
+    rpe.push_back({{"delta", p.delta},
+                   {"count", p.count},
+                   {"translation_rmse_m", p.translation_rmse_m},
+                   {"rotation_rmse_deg", p.rotation_rmse_deg}});
+  }
+  json["rpe"] = rpe;
+}
+
+}  // namespace
+
+nlohmann::json SlamJson(const SlamReport& r, double total_seconds) {
+  nlohmann::json json;
+  json["log"] = r.log_path;
+  json["dataset"] = r.dataset ? *r.dataset : "";
+  json["order"] = ToString(r.run.order);
+  json["scans"] = r.run.scans;
+  AddLoopJson(r, json);
+  if (r.evaluation.has_truth) AddLoopTruthJson(r.evaluation, json);
+  AddMapAndTimeJson(r, total_seconds, json);
+  json["config"] = ConfigJson(r.config);
+  if (const PaperSlamRow* paper = r.dataset ? PaperSlam(*r.dataset) : nullptr) {
+    json["paper"] = PaperJson(*paper);
+  }
+  if (r.evaluation.accuracy) AddAccuracyJson(*r.evaluation.accuracy, json);
+  if (r.evaluation.relations) json["relations"] = RelationJson(*r.evaluation.relations);
+  if (r.evaluation.relations_icp) json["relations_icp"] = RelationJson(*r.evaluation.relations_icp);
+  return json;
+}
+
+void WriteTrajectoryTsv(const std::string& path, const SlamRun& run) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "scan_index\ttimestamp_s\tx_m\ty_m\ttheta_rad\tsubmap\ticp_x_m\ticp_y_m\t"
+           "icp_theta_rad\n";
+    for (const OnlineSlam::ScanPose& pose : run.trajectory) {
+      out << fmt::format("{}\t{:.6f}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\n",
+                         pose.scan_index, pose.timestamp_s, pose.T_world_robot.x,
+                         pose.T_world_robot.y, pose.T_world_robot.theta, pose.submap,
+                         pose.T_world_robot_icp.x, pose.T_world_robot_icp.y,
+                         pose.T_world_robot_icp.theta);
+    }
+  });
+}
+
+void WriteLoopsTsv(const std::string& path, const SlamRun& run, const LoopEvaluation& e) {
+  const std::vector<LoopClosure>& loops = run.slam->loops();
+  const std::vector<Submap>& submaps = run.map.submaps;
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "query_submap\tquery_first_scan\treference_submap\treference_first_scan\tx_m\ty_m\t"
+           "theta_rad\tpairs\tconsensus\tgamma\tconfidence\toverlap\toverlap_0_2m\t"
+           "path_between_m\tgate_m\tgate_deg\taccepted\tused\ttruth_correct\ttruth_error_m\t"
+           "matched_submap\tref_x_m\tref_y_m\tref_theta_rad\toverlap_matched_ransac\trefined\t"
+           "refine_correction_m\trefine_correction_deg\tinlier_ratio_initial\tinlier_ratio\t"
+           "point_overlap\trefine_status\ttruth_error_deg\ttruth_error_ransac_m\t"
+           "truth_error_ransac_deg\toverlap_common\n";
+    for (std::size_t k = 0; k < loops.size(); ++k) {
+      const LoopClosure& l = loops[k];
+      out << fmt::format(
+          "{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t"
+          "{:.2f}\t{:.3f}\t{:.2f}\t{}\t{}\t{}\t{:.3f}\t{}\t{:.6f}\t{:.6f}\t{:.6f}\t{:.4f}\t{}\t"
+          "{:.4f}\t{:.3f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.3f}\t{:.3f}\t{:.3f}\t{:.4f}\n",
+          l.query_submap, submaps[l.query_submap].first_scan(), l.reference_submap,
+          submaps[l.reference_submap].first_scan(), l.T_ref_cur.x, l.T_ref_cur.y, l.T_ref_cur.theta,
+          l.pairs, l.consensus, l.gamma, l.confidence, e.overlap[k], e.overlap_coarse[k],
+          l.path_between_m, l.gate_translation_m, Deg(l.gate_rotation_rad), l.accepted ? 1 : 0,
+          e.used[k] ? 1 : 0, e.truth[k], e.truth_error_m[k], l.matched_submap,
+          l.T_matched_cur_ransac.x, l.T_matched_cur_ransac.y, l.T_matched_cur_ransac.theta,
+          e.overlap_matched_ransac[k], l.refined ? 1 : 0, l.refine_correction_m,
+          Deg(l.refine_correction_rad), l.refine_inlier_ratio_initial, l.refine_inlier_ratio,
+          l.point_overlap, ToString(l.refine_status), e.truth_error_deg[k],
+          e.truth_error_ransac_m[k], e.truth_error_ransac_deg[k], e.overlap_common[k]);
+    }
+  });
+}
+
+}  // namespace keyplace::cli

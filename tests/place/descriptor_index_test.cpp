@@ -1,0 +1,394 @@
+// The exact descriptor index against its oracle, exhaustive matching: the square-root bound
+// ||sqrt(x) - sqrt(y)||^2 <= 2 chi2_sym(x, y) on random and real descriptors, the same pairs on
+// random descriptor sets, and the same answer on every query of the bundled log.
+
+#include "place/descriptor_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/eval/global_localization.hpp"
+#include "keyplace/mapping/global_mapper.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
+#include "keyplace/place/place_recognizer.hpp"
+#include "support/test_data.hpp"
+
+namespace keyplace {
+namespace {
+
+using Index = PlaceRecognitionConfig::DescriptorIndex;
+
+// ||sqrt(x) - sqrt(y)||^2 in long double, zero bins as zero.
+double RootDistance2(const BetaGridDescriptor& x, const BetaGridDescriptor& y) {
+  long double sum = 0.0L;
+  for (int i = 0; i < kBetaGridBins; ++i) {
+    const long double d =
+        std::sqrt(static_cast<long double>(x[i])) - std::sqrt(static_cast<long double>(y[i]));
+    sum += d * d;
+  }
+  return static_cast<double>(sum);
+}
+
+// A random histogram over `support` random bins (0: all zero), normalised to 1 unless `raw`.
+BetaGridDescriptor RandomDescriptor(std::mt19937& rng, int support, bool raw = false) {
+  BetaGridDescriptor d{};
+  std::vector<int> bins(kBetaGridBins);
+  for (int i = 0; i < kBetaGridBins; ++i) bins[i] = i;
+  std::shuffle(bins.begin(), bins.end(), rng);
+  std::exponential_distribution<float> mass(1.0f);
+  float sum = 0.0f;
+  for (int k = 0; k < support; ++k) {
+    d[bins[k]] = mass(rng);
+    sum += d[bins[k]];
+  }
+  if (!raw && sum > 0.0f) {
+    for (float& v : d) v /= sum;
+  }
+  return d;
+}
+
+// `base` with each bin moved by up to +-`noise` (relative), some bins emptied or filled,
+// renormalised: pairs of these straddle the 0.4 threshold.
+BetaGridDescriptor Perturbed(const BetaGridDescriptor& base, float noise, std::mt19937& rng) {
+  std::uniform_real_distribution<float> factor(1.0f - noise, 1.0f + noise);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  BetaGridDescriptor d = base;
+  float sum = 0.0f;
+  for (float& v : d) {
+    const float u = unit(rng);
+    if (u < 0.05f) {
+      v = 0.0f;
+    } else if (u < 0.10f) {
+      v += 0.05f * unit(rng);
+    } else {
+      v *= factor(rng);
+    }
+    sum += v;
+  }
+  if (sum > 0.0f) {
+    for (float& v : d) v /= sum;
+  }
+  return d;
+}
+
+// The bound with the margin the index uses, and the ratio H / chi2.
+struct BoundCheck {
+  double max_ratio = 0.0;
+  int checked = 0;
+  int violations = 0;
+  void Add(const BetaGridDescriptor& x, const BetaGridDescriptor& y) {
+    const double chi2 = SymmetricChi2(x, y);
+    const double root2 = RootDistance2(x, y);
+    ++checked;
+    if (!(root2 <= 2.0 * chi2 * (1.0 + 1e-12) + 1e-12)) ++violations;
+    if (chi2 > 1e-6) max_ratio = std::max(max_ratio, root2 / chi2);
+  }
+};
+
+TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnRandomDescriptors) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> support(0, kBetaGridBins);
+  BoundCheck check;
+  for (int k = 0; k < 200000; ++k) {
+    const bool raw = k % 10 == 0;  // also histograms that do not sum to 1
+    const BetaGridDescriptor x = RandomDescriptor(rng, k % 7 == 0 ? 1 : support(rng), raw);
+    const BetaGridDescriptor y =
+        k % 3 == 0 ? Perturbed(x, 0.5f, rng) : RandomDescriptor(rng, support(rng), raw);
+    check.Add(x, y);
+  }
+  EXPECT_EQ(check.checked, 200000);
+  EXPECT_EQ(check.violations, 0);
+  EXPECT_LE(check.max_ratio, 2.0 + 1e-9);
+  // c = 2 is tight: disjoint supports reach it.
+  BetaGridDescriptor a{};
+  BetaGridDescriptor b{};
+  a[0] = 0.7f;
+  a[5] = 0.3f;
+  b[1] = 1.0f;
+  EXPECT_NEAR(RootDistance2(a, b) / SymmetricChi2(a, b), 2.0, 1e-12);
+  EXPECT_GT(check.max_ratio, 1.99);
+}
+
+// The bundled log, its map (default mapping) and its queries (Algorithm 4, 500 starts, default
+// query keypoints), built once.
+struct Bundled {
+  LogInputs inputs;
+  GlobalMap map;
+  std::vector<LocalizationQuery> queries;
+  std::vector<BetaGridDescriptor> descriptors;  // of every keypoint of every scan
+};
+
+const Bundled& BundledLog() {
+  static const Bundled bundled = [] {
+    Bundled b;
+    b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
+    b.map =
+        BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
+    const GroundTruth truth = TruthFromOwnPoses(b.inputs.log);
+    b.queries = BuildSubmapQueries(b.inputs, truth, b.map.config, QueryStarts(truth, 500),
+                                   PlaceRecognitionConfig{}.query_keypoints);
+    for (const auto& scan : b.inputs.keypoints) {
+      for (const Keypoint& keypoint : scan) b.descriptors.push_back(keypoint.descriptor);
+    }
+    return b;
+  }();
+  return bundled;
+}
+
+TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnTheBundledLog) {
+  const std::vector<BetaGridDescriptor>& all = BundledLog().descriptors;
+  ASSERT_GT(all.size(), 10000u);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::size_t> pick(0, all.size() - 1);
+  BoundCheck check;
+  for (int k = 0; k < 500000; ++k) check.Add(all[pick(rng)], all[pick(rng)]);
+  for (std::size_t k = 0; k + 1 < all.size(); ++k) check.Add(all[k], all[k + 1]);  // neighbours
+  EXPECT_EQ(check.violations, 0) << "of " << check.checked;
+  EXPECT_LE(check.max_ratio, 2.0 + 1e-9);
+  EXPECT_GT(check.max_ratio, 1.99);  // real descriptors with disjoint supports
+}
+
+// The distance as FLIRTLib writes it (a zero bin replaced by PSEUDOZERO in a branch), summed in
+// the same order: SymmetricChi2 (branch-free) must give the same doubles. (Here rather than in
+// tests/features: the index's results rest on it.)
+double FlirtLibChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b) {
+  const double pseudo_zero = std::numeric_limits<double>::min();
+  double sum = 0.0;
+  for (int i = 0; i < kBetaGridBins; ++i) {
+    const double q = a[i] == 0.0f ? pseudo_zero : static_cast<double>(a[i]);
+    const double p = b[i] == 0.0f ? pseudo_zero : static_cast<double>(b[i]);
+    sum += (q - p) * (q - p) / (q + p);
+  }
+  return 0.5 * sum;
+}
+
+TEST(DescriptorIndexBound, Chi2IsBitIdenticalToFlirtLibsBranchingPseudoZero) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  const float tiny = std::numeric_limits<float>::denorm_min();
+  for (int trial = 0; trial < 20000; ++trial) {
+    BetaGridDescriptor a;
+    BetaGridDescriptor b;
+    for (int i = 0; i < kBetaGridBins; ++i) {
+      const float u = uniform(rng);
+      a[i] = u < 0.5f ? 0.0f : (u < 0.52f ? tiny : (u < 0.53f ? -0.0f : uniform(rng)));
+      b[i] = uniform(rng) < 0.5f ? 0.0f : uniform(rng) * 1e-3f;
+    }
+    ASSERT_EQ(SymmetricChi2(a, b), FlirtLibChi2(a, b));
+    ASSERT_EQ(SymmetricChi2(b, a), FlirtLibChi2(b, a));
+  }
+  const std::vector<BetaGridDescriptor>& real = BundledLog().descriptors;
+  for (std::size_t k = 0; k + 1 < real.size(); ++k) {
+    ASSERT_EQ(SymmetricChi2(real[k], real[k + 1]), FlirtLibChi2(real[k], real[k + 1]));
+  }
+}
+
+TEST(DescriptorIndexBound, Chi2IfBelowIsTheChi2OrInfinity) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> support(0, kBetaGridBins);
+  const std::vector<BetaGridDescriptor>& real = BundledLog().descriptors;
+  for (std::size_t k = 0; k < 100000; ++k) {
+    const std::size_t r = k % (real.size() - 1);
+    const BetaGridDescriptor x = k % 2 ? RandomDescriptor(rng, support(rng)) : real[r];
+    const BetaGridDescriptor y = k % 4 == 1 ? Perturbed(x, 0.6f, rng)
+                                 : k % 2    ? RandomDescriptor(rng, support(rng))
+                                            : real[r + 1];
+    for (double threshold : {0.05, 0.4, 1.0}) {
+      const double below = SymmetricChi2IfBelow(x, y, threshold);
+      if (SymmetricChi2Below(x, y, threshold)) {
+        ASSERT_EQ(below, SymmetricChi2(x, y));
+      } else {
+        ASSERT_EQ(below, std::numeric_limits<double>::infinity());
+      }
+    }
+  }
+}
+
+// Places of random descriptors: bases, perturbed copies (pairs near the threshold), sparse ones,
+// all-zero ones, unnormalised ones, and some empty places.
+std::vector<Place> RandomPlaces(std::mt19937& rng, const std::vector<BetaGridDescriptor>& bases) {
+  std::uniform_int_distribution<int> size(0, 40);
+  std::uniform_int_distribution<int> kind(0, 9);
+  std::uniform_int_distribution<std::size_t> base(0, bases.size() - 1);
+  std::uniform_int_distribution<int> support(1, kBetaGridBins);
+  std::vector<Place> places(60);
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    places[p].id = static_cast<int>(p);
+    const int n = p % 13 == 5 ? 0 : size(rng);
+    for (int k = 0; k < n; ++k) {
+      const int what = kind(rng);
+      BetaGridDescriptor d{};
+      if (what < 6) {
+        d = Perturbed(bases[base(rng)], 0.8f, rng);
+      } else if (what < 8) {
+        d = RandomDescriptor(rng, what == 6 ? 2 : support(rng));
+      } else if (what == 8) {
+        d = RandomDescriptor(rng, support(rng), /*raw=*/true);
+      }  // else all zero
+      places[p].positions.emplace_back(k, p);
+      places[p].descriptors.push_back(d);
+    }
+  }
+  return places;
+}
+
+// The exhaustive pairs of MatchDescriptorPairs, before uniqueness: every (c, r, chi2) with
+// SymmetricChi2Below, by c then r.
+std::vector<DescriptorPair> ExhaustiveBelow(const std::vector<BetaGridDescriptor>& query,
+                                            const std::vector<BetaGridDescriptor>& reference,
+                                            double threshold) {
+  std::vector<DescriptorPair> below;
+  for (std::size_t c = 0; c < query.size(); ++c) {
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+      if (SymmetricChi2Below(query[c], reference[r], threshold)) {
+        below.push_back(
+            {static_cast<int>(c), static_cast<int>(r), SymmetricChi2(query[c], reference[r])});
+      }
+    }
+  }
+  return below;
+}
+
+TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> support(1, kBetaGridBins);
+  std::vector<BetaGridDescriptor> bases;
+  for (int k = 0; k < 12; ++k) bases.push_back(RandomDescriptor(rng, support(rng)));
+  std::size_t pairs_seen = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    const std::vector<Place> places = RandomPlaces(rng, bases);
+    // More query descriptors than one block of the dense product (64).
+    std::vector<BetaGridDescriptor> query;
+    for (const Place& place : RandomPlaces(rng, bases)) {
+      if (query.size() < 100) {
+        query.insert(query.end(), place.descriptors.begin(), place.descriptors.end());
+      }
+    }
+    query.push_back(BetaGridDescriptor{});  // an all-zero query descriptor
+    query.push_back(places[2].descriptors.empty() ? bases[0] : places[2].descriptors[0]);
+    std::vector<char> searched(places.size(), 1);
+    for (std::size_t p = 0; p < places.size(); p += 7) searched[p] = 0;
+    for (Index kind : {Index::kDense, Index::kKdTree}) {
+      const SqrtDescriptorIndex index(places, kind);
+      for (double threshold : {0.1, 0.4, 0.8}) {
+        std::vector<std::vector<DescriptorPair>> below;
+        index.FindPairs(query, threshold, searched, below);
+        ASSERT_EQ(below.size(), places.size());
+        for (std::size_t p = 0; p < places.size(); ++p) {
+          const std::vector<DescriptorPair> expected =
+              searched[p] ? ExhaustiveBelow(query, places[p].descriptors, threshold)
+                          : std::vector<DescriptorPair>{};
+          ASSERT_EQ(below[p].size(), expected.size()) << "place " << p;
+          for (std::size_t k = 0; k < expected.size(); ++k) {
+            EXPECT_EQ(below[p][k].current, expected[k].current);
+            EXPECT_EQ(below[p][k].reference, expected[k].reference);
+            EXPECT_EQ(below[p][k].distance, expected[k].distance);  // bit for bit
+          }
+          pairs_seen += expected.size();
+        }
+      }
+    }
+  }
+  EXPECT_GT(pairs_seen, 10000u);  // the sets do have pairs near every threshold
+}
+
+TEST(DescriptorIndex, NoneHasNoIndexAndEmptyMapsWork) {
+  EXPECT_THROW(SqrtDescriptorIndex({}, Index::kNone), std::invalid_argument);
+  const SqrtDescriptorIndex index(std::vector<Place>(3), Index::kKdTree);
+  std::vector<std::vector<DescriptorPair>> below;
+  index.FindPairs({BetaGridDescriptor{}}, 0.4, std::vector<char>(3, 1), below);
+  EXPECT_EQ(below.size(), 3u);
+  EXPECT_THROW(index.FindPairs({}, 0.4, std::vector<char>(2, 1), below), std::invalid_argument);
+}
+
+void ExpectSameMatch(const PlaceMatch& a, const PlaceMatch& b, const std::string& where) {
+  EXPECT_EQ(a.verified, b.verified) << where;
+  EXPECT_EQ(a.found, b.found) << where;
+  EXPECT_EQ(a.ambiguous, b.ambiguous) << where;
+  EXPECT_EQ(a.place_id, b.place_id) << where;
+  EXPECT_EQ(a.pairs, b.pairs) << where;
+  EXPECT_EQ(a.consensus, b.consensus) << where;
+  EXPECT_EQ(a.gamma, b.gamma) << where;
+  EXPECT_EQ(a.score, b.score) << where;
+  EXPECT_EQ(a.second_score, b.second_score) << where;
+  EXPECT_EQ(a.confidence, b.confidence) << where;
+  EXPECT_EQ(a.candidates, b.candidates) << where;
+  EXPECT_EQ(a.candidates_verified, b.candidates_verified) << where;
+  EXPECT_EQ(a.candidates_accepted, b.candidates_accepted) << where;
+  EXPECT_EQ(a.places_excluded, b.places_excluded) << where;
+  EXPECT_EQ(a.estimated_pose.x, b.estimated_pose.x) << where;
+  EXPECT_EQ(a.estimated_pose.y, b.estimated_pose.y) << where;
+  EXPECT_EQ(a.estimated_pose.theta, b.estimated_pose.theta) << where;
+  EXPECT_EQ(a.T_ref_cur.x, b.T_ref_cur.x) << where;
+  EXPECT_EQ(a.T_ref_cur.y, b.T_ref_cur.y) << where;
+  EXPECT_EQ(a.T_ref_cur.theta, b.T_ref_cur.theta) << where;
+}
+
+TEST(DescriptorIndex, RecognizerGivesTheSameMatchesOnRandomPlaces) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> support(1, kBetaGridBins);
+  std::vector<BetaGridDescriptor> bases;
+  for (int k = 0; k < 8; ++k) bases.push_back(RandomDescriptor(rng, support(rng)));
+  const std::vector<Place> places = RandomPlaces(rng, bases);
+  for (const PlaceRecognitionConfig& preset : {PlacePreset("default"), PlacePreset("paper")}) {
+    PlaceRecognitionConfig none = preset;
+    none.descriptor_index = Index::kNone;
+    PlaceRecognitionConfig config = preset;
+    config.min_gamma = config.min_gamma_all_scans = 0.0;
+    none.min_gamma = none.min_gamma_all_scans = 0.0;
+    const PlaceRecognizer oracle(places, none);
+    for (Index kind : {Index::kDense, Index::kKdTree}) {
+      config.descriptor_index = kind;
+      const PlaceRecognizer indexed(places, config);
+      for (std::size_t q = 0; q < places.size(); q += 3) {
+        PlaceQuery query;
+        query.positions = places[q].positions;
+        query.descriptors = places[q].descriptors;
+        const auto exclude = [q](const Place& place) { return place.id == static_cast<int>(q); };
+        ExpectSameMatch(indexed.Recognize(query, exclude), oracle.Recognize(query, exclude),
+                        "query " + std::to_string(q));
+      }
+    }
+  }
+}
+
+// Algorithm 4 on the bundled log (its map, 500 equally spaced starts, all-scan queries): every
+// answer of the dense index equals the exhaustive one; the kd-tree is compared on every 5th
+// query (the exhaustive answers take most of this test's time).
+TEST(DescriptorIndex, SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog) {
+  const Bundled& b = BundledLog();
+  ASSERT_GT(b.queries.size(), 480u);
+  const PlaceRecognitionConfig base;  // default preset
+  PlaceRecognitionConfig none = base;
+  none.descriptor_index = Index::kNone;
+  const std::vector<LocalizationRecord> expected = EvaluateQueries(
+      b.queries, PlaceRecognizer(PlacesFromMap(b.map), none), SelfMatchRule::kSameScans);
+  std::vector<LocalizationQuery> every_fifth;
+  for (std::size_t i = 0; i < b.queries.size(); i += 5) every_fifth.push_back(b.queries[i]);
+  int found = 0;
+  for (Index kind : {Index::kDense, Index::kKdTree}) {
+    PlaceRecognitionConfig config = base;
+    config.descriptor_index = kind;
+    const bool all = kind == Index::kDense;
+    const std::vector<LocalizationRecord> records =
+        EvaluateQueries(all ? b.queries : every_fifth,
+                        PlaceRecognizer(PlacesFromMap(b.map), config), SelfMatchRule::kSameScans);
+    ASSERT_EQ(records.size(), all ? expected.size() : every_fifth.size());
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      const std::size_t e = all ? i : 5 * i;
+      ExpectSameMatch(records[i].match, expected[e].match,
+                      "start " + std::to_string(b.queries[e].start_scan));
+      if (all) found += records[i].match.found ? 1 : 0;
+    }
+  }
+  EXPECT_GT(found, static_cast<int>(b.queries.size()) * 9 / 10);  // recall ~0.98
+}
+
+}  // namespace
+}  // namespace keyplace
