@@ -6,6 +6,24 @@
 #include "keyplace/store/map_file.hpp"
 
 namespace keyplace {
+namespace {
+
+// The answer of a recognition whose query pose (the latest scan) is T_odom_latest in odometry.
+LocalizationResult ResultOf(PlaceMatch match, const Pose2& T_odom_latest) {
+  LocalizationResult result;
+  result.match = std::move(match);
+  result.found = result.match.found;
+  result.ambiguous = result.match.ambiguous;
+  result.confidence = result.match.confidence;
+  if (result.match.verified) {
+    result.submap_id = result.match.place_id;
+    result.T_world_robot = result.match.estimated_pose;
+    result.T_world_odom = result.T_world_robot * T_odom_latest.inverse();
+  }
+  return result;
+}
+
+}  // namespace
 
 void Validate(const LocalizerConfig& config) {
   Validate(config.place);
@@ -68,19 +86,11 @@ LocalizationResult GlobalLocalizer::Localize() const {
   if (exclusion_) {
     exclude = [&](const Place& place) { return exclusion_(place, scan_ids); };
   }
-  LocalizationResult result;
-  result.match = recognizer_->Recognize(query, exclude);
+  LocalizationResult result =
+      ResultOf(recognizer_->Recognize(query, exclude), builder_.pose(latest));
   result.scans = builder_.size();
   result.scan_ids = std::move(scan_ids);
   result.T_odom_origin = builder_.pose(0);
-  result.found = result.match.found;
-  result.ambiguous = result.match.ambiguous;
-  result.confidence = result.match.confidence;
-  if (result.match.verified) {
-    result.submap_id = result.match.place_id;
-    result.T_world_robot = result.match.estimated_pose;
-    result.T_world_odom = result.T_world_robot * builder_.pose(latest).inverse();
-  }
   return result;
 }
 
@@ -92,18 +102,9 @@ LocalizationResult LocalizeScan(const PlaceRecognizer& recognizer, const LaserSc
     query.positions.push_back(scan.T_robot_laser * keypoint.position_m);
     query.descriptors.push_back(keypoint.descriptor);
   }
-  LocalizationResult result;
-  result.match = recognizer.Recognize(query, exclusion);
+  LocalizationResult result = ResultOf(recognizer.Recognize(query, exclusion), T_odom_robot);
   result.scans = 1;
   result.T_odom_origin = T_odom_robot;
-  result.found = result.match.found;
-  result.ambiguous = result.match.ambiguous;
-  result.confidence = result.match.confidence;
-  if (result.match.verified) {
-    result.submap_id = result.match.place_id;
-    result.T_world_robot = result.match.estimated_pose;
-    result.T_world_odom = result.T_world_robot * T_odom_robot.inverse();
-  }
   return result;
 }
 
