@@ -1,6 +1,8 @@
 #include "keyplace/localization/global_localizer.hpp"
 
+#include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "keyplace/store/map_file.hpp"
@@ -29,6 +31,29 @@ void Validate(const LocalizerConfig& config) {
   Validate(config.place);
   if (config.max_query_scans < 1) {
     throw std::invalid_argument("LocalizerConfig.max_query_scans must be >= 1");
+  }
+  Validate(config.fix);
+}
+
+void Validate(const FixPolicy& policy) {
+  if (policy.confirmations < 1) {
+    throw std::invalid_argument("FixPolicy.confirmations must be >= 1");
+  }
+  const auto require_positive = [](double value, const char* name) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument(std::string("FixPolicy.") + name +
+                                  " must be positive and finite");
+    }
+  };
+  require_positive(policy.agree_m, "agree_m");
+  require_positive(policy.agree_deg, "agree_deg");
+  require_positive(policy.window_m, "window_m");
+  require_positive(policy.lost_after_m, "lost_after_m");
+  if (!(policy.agree_per_m >= 0.0) || !std::isfinite(policy.agree_per_m)) {
+    throw std::invalid_argument("FixPolicy.agree_per_m must be >= 0 and finite");
+  }
+  if (!(policy.contradiction_confidence >= 0.0 && policy.contradiction_confidence <= 1.0)) {
+    throw std::invalid_argument("FixPolicy.contradiction_confidence must be in [0, 1]");
   }
 }
 

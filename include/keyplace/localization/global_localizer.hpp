@@ -30,14 +30,35 @@
 
 namespace keyplace {
 
+/// When the answers of the localizer make a fix, keep it, or lose it (Relocalizer).
+struct FixPolicy {
+  // Accepted answers that must agree through odometry before the first fix (1: every accepted
+  // answer is a fix).
+  int confirmations = 2;
+  // Two answers agree when they put the robot now within agree_m + agree_per_m * (odometry
+  // distance between them) and agree_deg of each other: the slack is odometry drift.
+  double agree_m = 1.0;
+  double agree_per_m = 0.02;
+  double agree_deg = 10.0;
+  // Accepted answers older than this (odometry distance) are forgotten while searching.
+  double window_m = 20.0;
+  // A fix that no answer confirmed over this odometry distance is given up (lost).
+  double lost_after_m = 20.0;
+  // One accepted answer at least this confident that contradicts the fix gives it up at once;
+  // less confident ones must agree with each other (confirmations of them) first.
+  double contradiction_confidence = 0.9;
+};
+
 struct LocalizerConfig {
   PlaceRecognitionConfig place;  // the top-level `place` section
   // A query submap that is not complete after this many scans is recognised as it stands (when
   // the map's own max_scans_per_submap is smaller, that one closes it first). Bounds memory.
   int max_query_scans = 300;
+  FixPolicy fix;  // the Relocalizer's
 };
 
-/// Throws std::invalid_argument naming the first invalid field.
+/// Throw std::invalid_argument naming the first invalid field.
+void Validate(const FixPolicy& policy);
 void Validate(const LocalizerConfig& config);
 
 /// One answer of the localizer.

@@ -1,0 +1,101 @@
+#pragma once
+// The kidnapped-robot benchmark: from each of N starts spread over a query log, a Relocalizer
+// that knows nothing is fed scans and odometry until it declares a fix or gives up (a cap on the
+// distance travelled, or the end of the log); after its first fix it keeps running for a further
+// stretch and every fix it reports is checked against the ground truth. This is how a robot
+// lives with a localizer: a stream of scans, not isolated queries.
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/mapping/global_map.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
+
+namespace keyplace {
+
+struct RelocalizationOptions {
+  int starts = 50;
+  double give_up_m = 50.0;  // odometry distance without a fix after which a start is given up
+  double follow_m = 20.0;   // odometry distance after the first fix during which fixes are checked
+  // Protocol (a): the localizer never matches a map submap that shares a scan with its current
+  // query. Only meaningful when the query log is the map's own log (TruthIsMapLog).
+  bool exclude_shared_scans = true;
+  double correct_m = 0.5;  // a fix is correct within these of the truth
+  double correct_deg = 10.0;
+  double revisit_m = 1.5;  // a start has a revisit when its path comes this close to a map scan
+  double revisit_deg = 45.0;
+  double confident = 0.9;  // a fix at least this confident is "confident"
+};
+
+/// One fix the relocalizer reported (at an update where a query was answered).
+struct FixEvent {
+  int scan = 0;  // query-log scan (index into the log's scans)
+  Pose2 T_world_robot;
+  Pose2 truth;
+  double confidence = 0.0;
+  bool correct = false;
+  bool first = false;  // the start's first fix
+};
+
+/// One start.
+struct StartRecord {
+  int start_scan = 0;
+  int end_scan = 0;      // one past the last scan fed
+  bool revisit = false;  // the path before the cap passes a map scan the localizer may match
+  bool fixed = false;
+  int scans_to_fix = 0;  // scans fed up to and including the first fix
+  double distance_to_fix_m = 0.0;
+  bool first_fix_correct = false;
+  int answers = 0;           // queries answered
+  int answers_accepted = 0;  // of them accepted by the place recognizer
+  std::vector<FixEvent> fixes;
+  int wrong_fixes = 0;
+  int lost = 0;                   // "lost" signals
+  int lost_on_correct_track = 0;  // of them while the fix was right
+  int lost_on_wrong_track = 0;    // "lost" while the fix was wrong (the signal did its job)
+  double update_seconds_mean = 0.0;
+  double update_seconds_max = 0.0;
+};
+
+struct RelocalizationSummary {
+  std::size_t starts = 0;
+  std::size_t starts_with_revisit = 0;
+  std::size_t fixed = 0;               // starts with a first fix
+  std::size_t fixed_with_revisit = 0;  // of the starts with a revisit
+  double fixed_fraction = 0.0;         // fixed_with_revisit / starts_with_revisit
+  std::size_t fixes = 0;
+  std::size_t wrong_fixes = 0;
+  double wrong_fix_rate = 0.0;            // wrong_fixes / fixes
+  std::size_t wrong_first_fixes = 0;      // starts whose first fix was wrong
+  bool wrong_fix_confident = false;       // a wrong fix had confidence >= options.confident
+  double wrong_fix_confidence_max = 0.0;  // 0 without wrong fixes
+  double distance_to_fix_median_m = 0.0;  // over fixed starts
+  double distance_to_fix_p90_m = 0.0;
+  double scans_to_fix_median = 0.0;
+  double update_seconds_mean = 0.0;  // per AddScan with keypoints given, over all updates
+  double update_seconds_max = 0.0;
+  std::size_t lost_signals = 0;  // the two below, and those with no truth to tell
+  std::size_t lost_on_correct_track = 0;
+  std::size_t lost_on_wrong_track = 0;
+};
+
+/// Progress: (starts done, starts in all).
+using StartProgress = std::function<void(std::size_t, std::size_t)>;
+
+/// Runs the benchmark on `inputs` (poses = the odometry fed to the localizer, keypoints
+/// extracted) against `map`. With exclude_shared_scans, the localizer's scan ids are the truth
+/// indices of the scans (GroundTruth::truth_index_of_scan) and map submaps sharing one with the
+/// current query are skipped.
+std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs& inputs,
+                                           const GroundTruth& truth, const LocalizerConfig& config,
+                                           const RelocalizationOptions& options,
+                                           const StartProgress& progress = {});
+
+RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& records,
+                                              const RelocalizationOptions& options);
+
+}  // namespace keyplace

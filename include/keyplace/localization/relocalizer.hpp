@@ -1,0 +1,133 @@
+#pragma once
+// A localizer a robot can act on: the GlobalLocalizer's answers, one per query submap, turned
+// into a fix only when they agree with each other through odometry, then a track that every
+// later answer must confirm, and a "lost" signal when none does or a confident one contradicts
+// it.
+//
+// Why agreement: two query submaps built from different scans are matched independently, so a
+// wrong answer that happens to agree (within a metre, through odometry) with another wrong answer
+// is far rarer than a single wrong answer, while correct answers agree by construction. Two
+// identical rooms give ambiguous answers (never accepted); the fix comes when motion brings the
+// robot somewhere that tells them apart.
+//
+//   keyplace::Relocalizer relocalizer(keyplace::LoadMap("site.kpm"));
+//   for (each scan, odometry pose) {
+//     const keyplace::RelocalizationUpdate update = relocalizer.AddScan(scan, T_odom_robot);
+//     if (update.status == keyplace::FixStatus::kFixed) drive(update.T_world_robot);
+//     if (update.lost) stop_and_search();
+//   }
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/flirt.hpp"
+#include "keyplace/features/keypoint.hpp"
+#include "keyplace/io/laser_scan.hpp"
+#include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/mapping/global_map.hpp"
+
+namespace keyplace {
+
+enum class FixStatus {
+  kSearching,  // no fix: answers are collected until enough of them agree
+  kFixed,      // the pose is known and confirmed by the answers
+  kLost,       // there was a fix, but the answers stopped confirming it: searching again
+};
+std::string ToString(FixStatus status);
+
+/// The result of one scan.
+struct RelocalizationUpdate {
+  FixStatus status = FixStatus::kSearching;
+  // A fix was declared with this scan: the first one, or a new one after a loss or after
+  // confirmed contradicting answers.
+  bool new_fix = false;
+  // The fix was given up with this scan (status is kLost or, when answers already agree on
+  // another pose, kFixed with new_fix).
+  bool lost = false;
+  // Valid when status is kFixed: the robot's pose in the map now, the map <- odometry transform,
+  // and the confidence of the fix (1 - product of (1 - confidence) of the agreeing answers).
+  Pose2 T_world_robot;
+  Pose2 T_world_odom;
+  double confidence = 0.0;
+  // Odometry distance since the last answer that confirmed the fix (0 without a fix).
+  double unconfirmed_m = 0.0;
+  // The localizer's answer when a query submap completed with this scan.
+  std::optional<LocalizationResult> answer;
+  // The answer was accepted and agreed with the fix (confirmation) or contradicted it.
+  bool confirmed = false;
+  bool contradicted = false;
+};
+
+/// The temporal part alone: turns a stream of answers (one per scan, most of them none) into
+/// fixes, confirmations and losses. Relocalizer feeds it the GlobalLocalizer's answers; tests
+/// and other front ends can feed it their own.
+class FixFilter {
+ public:
+  /// Throws std::invalid_argument for an invalid policy (naming the field).
+  explicit FixFilter(const FixPolicy& policy = {});
+
+  /// The next scan: its odometry pose and the answer that came with it, if any.
+  RelocalizationUpdate Update(std::optional<LocalizationResult> answer, const Pose2& T_odom_robot);
+
+  void Reset();
+  FixStatus status() const { return status_; }
+
+ private:
+  // An accepted answer, kept as a hypothesis of T_world_odom.
+  struct Hypothesis {
+    Pose2 T_world_odom;
+    double confidence = 0.0;
+    double odometry_m = 0.0;  // odometry distance when it was given
+  };
+
+  void Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
+              RelocalizationUpdate& update);
+  void Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot, RelocalizationUpdate& update);
+  // The hypotheses in `pool` that agree with `hypothesis` at the robot's current pose.
+  std::vector<Hypothesis> Agreeing(const std::vector<Hypothesis>& pool,
+                                   const Hypothesis& hypothesis, const Pose2& T_odom_robot) const;
+  void Forget(std::vector<Hypothesis>& pool) const;  // drops those older than window_m
+  void DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest,
+                  RelocalizationUpdate& update);
+  void DeclareLost(RelocalizationUpdate& update);
+
+  FixPolicy policy_;
+  FixStatus status_ = FixStatus::kSearching;
+  std::optional<Pose2> last_T_odom_robot_;
+  double odometry_m_ = 0.0;
+  std::vector<Hypothesis> hypotheses_;   // accepted answers while searching
+  std::vector<Hypothesis> challengers_;  // accepted answers contradicting the fix
+  Pose2 T_world_odom_;                   // the fix
+  double fix_confidence_ = 0.0;
+  double confirmed_at_m_ = 0.0;  // odometry distance of the last confirmation
+};
+
+class Relocalizer {
+ public:
+  /// Throws std::invalid_argument for an invalid config (naming the field).
+  explicit Relocalizer(const GlobalMap& map, const LocalizerConfig& config = {},
+                       const FlirtConfig& features = {});
+
+  /// Adds the next scan with the robot's pose in its odometry frame.
+  RelocalizationUpdate AddScan(const LaserScan& scan, const Pose2& T_odom_robot);
+
+  /// The same with the scan's keypoints already extracted (laser frame) and the caller's id of the
+  /// scan (for the exclusion of GlobalLocalizer::set_exclusion).
+  RelocalizationUpdate AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
+                               std::vector<Keypoint> keypoints, int scan_id = -1);
+
+  /// Forgets everything: fix, hypotheses and the query being built (the robot was kidnapped).
+  void Reset();
+
+  void set_exclusion(QueryExclusion exclusion) { localizer_.set_exclusion(std::move(exclusion)); }
+  FixStatus status() const { return filter_.status(); }
+  const GlobalLocalizer& localizer() const { return localizer_; }
+
+ private:
+  GlobalLocalizer localizer_;
+  FixFilter filter_;
+};
+
+}  // namespace keyplace

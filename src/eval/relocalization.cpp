@@ -1,0 +1,247 @@
+#include "keyplace/eval/relocalization.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "keyplace/eval/global_localization.hpp"
+#include "keyplace/eval/localization.hpp"
+#include "keyplace/localization/relocalizer.hpp"
+
+namespace keyplace {
+namespace {
+
+constexpr double kRadPerDeg = M_PI / 180.0;
+
+bool Within(const Pose2& a, const Pose2& b, double max_m, double max_deg) {
+  const Pose2 difference = Between(a, b);
+  return TranslationNorm(difference) <= max_m && std::abs(difference.theta) <= max_deg * kRadPerDeg;
+}
+
+// The map's scans a query at truth index t may be matched with: under protocol (a) those of
+// submaps sharing no scan with the query's neighbourhood [t - B, t + B], B = the mean submap
+// length (a query submap is built like the map's).
+class RevisitChecker {
+ public:
+  RevisitChecker(const GlobalMap& map, const RelocalizationOptions& options) : options_(options) {
+    std::size_t scans = 0;
+    for (const Submap& submap : map.submaps) {
+      if (submap.scan_indices.empty()) continue;
+      const auto [low, high] =
+          std::minmax_element(submap.scan_indices.begin(), submap.scan_indices.end());
+      for (const Pose2& pose : submap.poses) scans_.push_back({pose, *low, *high});
+      scans += submap.scan_indices.size();
+    }
+    if (!map.submaps.empty()) {
+      neighbourhood_ = static_cast<int>(
+          std::ceil(static_cast<double>(scans) / static_cast<double>(map.submaps.size())));
+    }
+  }
+
+  bool IsRevisit(const Pose2& truth, int truth_index) const {
+    for (const MapScan& scan : scans_) {
+      if (options_.exclude_shared_scans && truth_index >= 0 &&
+          scan.last_scan >= truth_index - neighbourhood_ &&
+          scan.first_scan <= truth_index + neighbourhood_) {
+        continue;
+      }
+      if (Within(scan.pose, truth, options_.revisit_m, options_.revisit_deg)) return true;
+    }
+    return false;
+  }
+
+ private:
+  struct MapScan {
+    Pose2 pose;
+    int first_scan = 0;  // of its submap
+    int last_scan = 0;
+  };
+  const RelocalizationOptions& options_;
+  std::vector<MapScan> scans_;
+  int neighbourhood_ = 0;
+};
+
+// The truth at scan k or the next scan with one (a raw log has scans without a corrected twin).
+std::optional<std::size_t> ScanWithTruth(const GroundTruth& truth, std::size_t k, std::size_t end) {
+  for (std::size_t j = k; j < end && j < k + 10; ++j) {
+    if (truth.Has(j)) return j;
+  }
+  return std::nullopt;
+}
+
+class StartRun {
+ public:
+  StartRun(Relocalizer& relocalizer, const LogInputs& inputs, const GroundTruth& truth,
+           const RevisitChecker& revisits, const RelocalizationOptions& options)
+      : relocalizer_(relocalizer),
+        inputs_(inputs),
+        truth_(truth),
+        revisits_(revisits),
+        options_(options) {}
+
+  StartRecord Run(int start_scan) {
+    relocalizer_.Reset();
+    record_ = StartRecord{};
+    record_.start_scan = start_scan;
+    const std::size_t scans = inputs_.log.scans.size();
+    double travelled_m = 0.0;
+    double fixed_at_m = 0.0;
+    double seconds_sum = 0.0;
+    std::size_t k = static_cast<std::size_t>(start_scan);
+    for (; k < scans; ++k) {
+      if (k > static_cast<std::size_t>(start_scan)) {
+        travelled_m += TranslationNorm(Between(inputs_.poses[k - 1], inputs_.poses[k]));
+      }
+      if (!record_.fixed && travelled_m > options_.give_up_m) break;
+      if (record_.fixed && travelled_m > fixed_at_m + options_.follow_m) break;
+      if (!record_.fixed && !record_.revisit && truth_.Has(k)) {
+        record_.revisit = revisits_.IsRevisit(truth_.Pose(k), truth_.truth_index_of_scan[k]);
+      }
+      const auto begin = std::chrono::steady_clock::now();
+      const RelocalizationUpdate update =
+          relocalizer_.AddScan(inputs_.log.scans[k], inputs_.poses[k], inputs_.keypoints[k],
+                               options_.exclude_shared_scans ? TruthIndex(k) : -1);
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+      seconds_sum += seconds;
+      record_.update_seconds_max = std::max(record_.update_seconds_max, seconds);
+      Record(update, k, travelled_m);
+      if (update.new_fix && !record_.fixed) {
+        record_.fixed = true;
+        fixed_at_m = travelled_m;
+      }
+    }
+    record_.end_scan = static_cast<int>(k);
+    const int fed = record_.end_scan - start_scan;
+    if (fed > 0) record_.update_seconds_mean = seconds_sum / fed;
+    return record_;
+  }
+
+ private:
+  int TruthIndex(std::size_t k) const { return truth_.Has(k) ? truth_.truth_index_of_scan[k] : -1; }
+
+  void Record(const RelocalizationUpdate& update, std::size_t k, double travelled_m) {
+    if (update.lost) RecordLost(k);
+    if (update.status == FixStatus::kFixed) previous_T_world_odom_ = update.T_world_odom;
+    if (!update.answer) return;
+    ++record_.answers;
+    if (update.answer->found) ++record_.answers_accepted;
+    if (update.status != FixStatus::kFixed) return;
+    const bool first = !record_.fixed && update.new_fix;
+    if (first) {
+      record_.scans_to_fix = static_cast<int>(k) - record_.start_scan + 1;
+      record_.distance_to_fix_m = travelled_m;
+    }
+    const std::optional<std::size_t> checked = ScanWithTruth(truth_, k, inputs_.log.scans.size());
+    if (!checked) return;
+    FixEvent fix;
+    fix.scan = static_cast<int>(k);
+    fix.T_world_robot = update.T_world_odom * inputs_.poses[*checked];
+    fix.truth = truth_.Pose(*checked);
+    fix.confidence = update.confidence;
+    fix.correct = Within(fix.T_world_robot, fix.truth, options_.correct_m, options_.correct_deg);
+    fix.first = first;
+    if (first) record_.first_fix_correct = fix.correct;
+    if (!fix.correct) ++record_.wrong_fixes;
+    record_.fixes.push_back(fix);
+  }
+
+  void RecordLost(std::size_t k) {
+    ++record_.lost;
+    const std::optional<std::size_t> checked = ScanWithTruth(truth_, k, inputs_.log.scans.size());
+    if (!checked || !previous_T_world_odom_) return;
+    const Pose2 track = *previous_T_world_odom_ * inputs_.poses[*checked];
+    if (Within(track, truth_.Pose(*checked), options_.correct_m, options_.correct_deg)) {
+      ++record_.lost_on_correct_track;
+    } else {
+      ++record_.lost_on_wrong_track;
+    }
+  }
+
+  Relocalizer& relocalizer_;
+  const LogInputs& inputs_;
+  const GroundTruth& truth_;
+  const RevisitChecker& revisits_;
+  const RelocalizationOptions& options_;
+  StartRecord record_;
+  std::optional<Pose2> previous_T_world_odom_;
+};
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double position = q * static_cast<double>(values.size() - 1);
+  const auto low = static_cast<std::size_t>(std::floor(position));
+  const std::size_t high = std::min(low + 1, values.size() - 1);
+  const double fraction = position - static_cast<double>(low);
+  return values[low] + fraction * (values[high] - values[low]);
+}
+
+}  // namespace
+
+std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs& inputs,
+                                           const GroundTruth& truth, const LocalizerConfig& config,
+                                           const RelocalizationOptions& options,
+                                           const StartProgress& progress) {
+  Relocalizer relocalizer(map, config);
+  if (options.exclude_shared_scans) {
+    relocalizer.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
+      return IsSelfMatch(SelfMatchRule::kSharedScan, query_scans, place.scan_indices);
+    });
+  }
+  const RevisitChecker revisits(map, options);
+  const std::vector<int> starts = QueryStarts(truth, options.starts);
+  std::vector<StartRecord> records;
+  for (const int start : starts) {
+    StartRun run(relocalizer, inputs, truth, revisits, options);
+    records.push_back(run.Run(start));
+    if (progress) progress(records.size(), starts.size());
+  }
+  return records;
+}
+
+RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& records,
+                                              const RelocalizationOptions& options) {
+  RelocalizationSummary s;
+  s.starts = records.size();
+  std::vector<double> distances;
+  std::vector<double> scans_to_fix;
+  double seconds_sum = 0.0;
+  std::size_t updates = 0;
+  for (const StartRecord& r : records) {
+    s.starts_with_revisit += r.revisit ? 1 : 0;
+    if (r.fixed) {
+      ++s.fixed;
+      s.fixed_with_revisit += r.revisit ? 1 : 0;
+      distances.push_back(r.distance_to_fix_m);
+      scans_to_fix.push_back(r.scans_to_fix);
+      if (!r.first_fix_correct) ++s.wrong_first_fixes;
+    }
+    for (const FixEvent& fix : r.fixes) {
+      ++s.fixes;
+      if (fix.correct) continue;
+      ++s.wrong_fixes;
+      s.wrong_fix_confidence_max = std::max(s.wrong_fix_confidence_max, fix.confidence);
+      if (fix.confidence >= options.confident) s.wrong_fix_confident = true;
+    }
+    s.lost_signals += static_cast<std::size_t>(r.lost);
+    s.lost_on_correct_track += r.lost_on_correct_track;
+    s.lost_on_wrong_track += r.lost_on_wrong_track;
+    const int fed = r.end_scan - r.start_scan;
+    seconds_sum += r.update_seconds_mean * fed;
+    updates += static_cast<std::size_t>(std::max(fed, 0));
+    s.update_seconds_max = std::max(s.update_seconds_max, r.update_seconds_max);
+  }
+  if (s.starts_with_revisit > 0) {
+    s.fixed_fraction = static_cast<double>(s.fixed_with_revisit) / s.starts_with_revisit;
+  }
+  if (s.fixes > 0) s.wrong_fix_rate = static_cast<double>(s.wrong_fixes) / s.fixes;
+  s.distance_to_fix_median_m = Quantile(distances, 0.5);
+  s.distance_to_fix_p90_m = Quantile(distances, 0.9);
+  s.scans_to_fix_median = Quantile(scans_to_fix, 0.5);
+  if (updates > 0) s.update_seconds_mean = seconds_sum / static_cast<double>(updates);
+  return s;
+}
+
+}  // namespace keyplace

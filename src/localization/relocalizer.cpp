@@ -1,0 +1,177 @@
+#include "keyplace/localization/relocalizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace keyplace {
+namespace {
+
+constexpr double kRadPerDeg = M_PI / 180.0;
+
+// 1 - prod(1 - c): the chance that not all of independent answers are wrong.
+double CombinedConfidence(const std::vector<double>& confidences) {
+  double all_wrong = 1.0;
+  for (const double confidence : confidences) all_wrong *= 1.0 - std::clamp(confidence, 0.0, 1.0);
+  return 1.0 - all_wrong;
+}
+
+}  // namespace
+
+std::string ToString(FixStatus status) {
+  switch (status) {
+    case FixStatus::kSearching:
+      return "searching";
+    case FixStatus::kFixed:
+      return "fixed";
+    case FixStatus::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
+                         const FlirtConfig& features)
+    : localizer_(map, config, features), filter_(config.fix) {}
+
+RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
+  return filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
+}
+
+RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
+                                          std::vector<Keypoint> keypoints, int scan_id) {
+  return filter_.Update(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id),
+                        T_odom_robot);
+}
+
+void Relocalizer::Reset() {
+  localizer_.Reset();
+  filter_.Reset();
+}
+
+FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(policy_); }
+
+void FixFilter::Reset() {
+  status_ = FixStatus::kSearching;
+  last_T_odom_robot_.reset();
+  odometry_m_ = 0.0;
+  hypotheses_.clear();
+  challengers_.clear();
+  fix_confidence_ = 0.0;
+  confirmed_at_m_ = 0.0;
+}
+
+RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
+                                       const Pose2& T_odom_robot) {
+  if (last_T_odom_robot_) {
+    odometry_m_ += TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
+  }
+  last_T_odom_robot_ = T_odom_robot;
+
+  RelocalizationUpdate update;
+  if (answer && answer->found) {
+    const Hypothesis hypothesis{answer->T_world_odom, answer->confidence, odometry_m_};
+    if (status_ == FixStatus::kFixed) {
+      Track(hypothesis, T_odom_robot, update);
+    } else {
+      Search(hypothesis, T_odom_robot, update);
+    }
+  }
+  if (status_ == FixStatus::kFixed && odometry_m_ - confirmed_at_m_ > policy_.lost_after_m) {
+    DeclareLost(update);
+  }
+  update.answer = std::move(answer);
+  update.status = status_;
+  if (status_ == FixStatus::kFixed) {
+    update.T_world_odom = T_world_odom_;
+    update.T_world_robot = T_world_odom_ * T_odom_robot;
+    update.confidence = fix_confidence_;
+    update.unconfirmed_m = odometry_m_ - confirmed_at_m_;
+  }
+  return update;
+}
+
+void FixFilter::Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
+                       RelocalizationUpdate& update) {
+  Forget(hypotheses_);
+  const std::vector<Hypothesis> agreeing = Agreeing(hypotheses_, hypothesis, T_odom_robot);
+  if (static_cast<int>(agreeing.size()) + 1 >= policy_.confirmations) {
+    DeclareFix(agreeing, hypothesis, update);
+  } else {
+    hypotheses_.push_back(hypothesis);
+  }
+}
+
+void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
+                      RelocalizationUpdate& update) {
+  const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_};
+  if (!Agreeing({fix}, hypothesis, T_odom_robot).empty()) {
+    // The newest answer carries the least odometry drift.
+    T_world_odom_ = hypothesis.T_world_odom;
+    fix_confidence_ = CombinedConfidence({fix_confidence_, hypothesis.confidence});
+    confirmed_at_m_ = odometry_m_;
+    challengers_.clear();
+    update.confirmed = true;
+    return;
+  }
+  update.contradicted = true;
+  Forget(challengers_);
+  const std::vector<Hypothesis> agreeing = Agreeing(challengers_, hypothesis, T_odom_robot);
+  if (static_cast<int>(agreeing.size()) + 1 >= policy_.confirmations) {
+    DeclareLost(update);
+    DeclareFix(agreeing, hypothesis, update);
+  } else if (hypothesis.confidence >= policy_.contradiction_confidence) {
+    DeclareLost(update);
+    hypotheses_.push_back(hypothesis);
+  } else {
+    challengers_.push_back(hypothesis);
+  }
+}
+
+std::vector<FixFilter::Hypothesis> FixFilter::Agreeing(const std::vector<Hypothesis>& pool,
+                                                       const Hypothesis& hypothesis,
+                                                       const Pose2& T_odom_robot) const {
+  const Pose2 T_world_robot = hypothesis.T_world_odom * T_odom_robot;
+  std::vector<Hypothesis> agreeing;
+  for (const Hypothesis& other : pool) {
+    const Pose2 difference = Between(other.T_world_odom * T_odom_robot, T_world_robot);
+    const double travelled_m = std::abs(hypothesis.odometry_m - other.odometry_m);
+    const double tolerance_m = policy_.agree_m + policy_.agree_per_m * travelled_m;
+    if (TranslationNorm(difference) <= tolerance_m &&
+        std::abs(difference.theta) <= policy_.agree_deg * kRadPerDeg) {
+      agreeing.push_back(other);
+    }
+  }
+  return agreeing;
+}
+
+void FixFilter::Forget(std::vector<Hypothesis>& pool) const {
+  pool.erase(std::remove_if(pool.begin(), pool.end(),
+                            [&](const Hypothesis& h) {
+                              return odometry_m_ - h.odometry_m > policy_.window_m;
+                            }),
+             pool.end());
+}
+
+void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest,
+                           RelocalizationUpdate& update) {
+  std::vector<double> confidences{latest.confidence};
+  for (const Hypothesis& h : agreeing) confidences.push_back(h.confidence);
+  status_ = FixStatus::kFixed;
+  T_world_odom_ = latest.T_world_odom;
+  fix_confidence_ = CombinedConfidence(confidences);
+  confirmed_at_m_ = odometry_m_;
+  hypotheses_.clear();
+  challengers_.clear();
+  update.new_fix = true;
+}
+
+void FixFilter::DeclareLost(RelocalizationUpdate& update) {
+  status_ = FixStatus::kLost;
+  fix_confidence_ = 0.0;
+  hypotheses_.clear();
+  challengers_.clear();
+  update.lost = true;
+}
+
+}  // namespace keyplace

@@ -1,0 +1,167 @@
+#include <cmath>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/localization/relocalizer.hpp"
+
+namespace keyplace {
+namespace {
+
+// An accepted answer saying the odometry frame sits at T_world_odom in the map.
+LocalizationResult Answer(const Pose2& T_world_odom, double confidence = 0.5) {
+  LocalizationResult answer;
+  answer.found = true;
+  answer.confidence = confidence;
+  answer.T_world_odom = T_world_odom;
+  return answer;
+}
+
+// The robot drives along +x in its odometry frame, 0.25 m per scan.
+Pose2 Odometry(int scan) { return {0.25 * scan, 0.0, 0.0}; }
+
+const Pose2 kTrue(10.0, 5.0, 0.3);  // the true map <- odometry transform
+const Pose2 kWrong(-20.0, 3.0, 2.0);
+
+TEST(FixFilter, OneAnswerIsNotAFixTwoThatAgreeAre) {
+  FixFilter filter;
+  RelocalizationUpdate update = filter.Update(Answer(kTrue), Odometry(0));
+  EXPECT_EQ(update.status, FixStatus::kSearching);
+  EXPECT_FALSE(update.new_fix);
+  for (int scan = 1; scan < 6; ++scan) {
+    EXPECT_EQ(filter.Update(std::nullopt, Odometry(scan)).status, FixStatus::kSearching);
+  }
+  // The second answer is a little off (0.3 m): they agree through odometry.
+  update = filter.Update(Answer(kTrue * Pose2(0.3, 0.0, 0.02)), Odometry(6));
+  ASSERT_EQ(update.status, FixStatus::kFixed);
+  EXPECT_TRUE(update.new_fix);
+  EXPECT_NEAR(update.confidence, 0.75, 1e-12);  // 1 - 0.5 * 0.5
+  // The fix follows odometry from the newest answer.
+  update = filter.Update(std::nullopt, Odometry(8));
+  const Pose2 expected = kTrue * Pose2(0.3, 0.0, 0.02) * Odometry(8);
+  EXPECT_NEAR(update.T_world_robot.x, expected.x, 1e-9);
+  EXPECT_NEAR(update.T_world_robot.y, expected.y, 1e-9);
+  EXPECT_FALSE(update.new_fix);
+}
+
+TEST(FixFilter, AnswersThatDisagreeGiveNoFix) {
+  FixFilter filter;
+  filter.Update(Answer(kTrue), Odometry(0));
+  const RelocalizationUpdate update = filter.Update(Answer(kWrong), Odometry(5));
+  EXPECT_EQ(update.status, FixStatus::kSearching);
+  // 1.5 m apart is beyond agree_m + agree_per_m * 1.25 m.
+  EXPECT_EQ(filter.Update(Answer(kTrue * Pose2(0.0, 1.5, 0.0)), Odometry(10)).status,
+            FixStatus::kSearching);
+  // But the third answer agreeing with the first makes the fix.
+  EXPECT_EQ(filter.Update(Answer(kTrue * Pose2(0.1, 0.0, 0.0)), Odometry(15)).status,
+            FixStatus::kFixed);
+}
+
+TEST(FixFilter, AnswersNotAcceptedAreIgnored) {
+  FixFilter filter;
+  LocalizationResult ambiguous = Answer(kTrue);
+  ambiguous.found = false;
+  ambiguous.ambiguous = true;
+  filter.Update(ambiguous, Odometry(0));
+  EXPECT_EQ(filter.Update(Answer(kTrue), Odometry(5)).status, FixStatus::kSearching);
+}
+
+TEST(FixFilter, OdometryDriftWidensAgreementWithDistance) {
+  FixPolicy policy;
+  policy.agree_m = 0.5;
+  policy.agree_per_m = 0.05;
+  FixFilter near(policy);
+  near.Update(Answer(kTrue), Odometry(0));
+  // 0.8 m apart after 2.5 m: 0.5 + 0.125 < 0.8, no agreement.
+  EXPECT_EQ(near.Update(Answer(kTrue * Pose2(0.0, 0.8, 0.0)), Odometry(10)).status,
+            FixStatus::kSearching);
+  FixFilter far(policy);
+  far.Update(Answer(kTrue), Odometry(0));
+  // 0.8 m apart after 10 m: 0.5 + 0.5 > 0.8, agreement.
+  EXPECT_EQ(far.Update(Answer(kTrue * Pose2(0.0, 0.8, 0.0)), Odometry(40)).status,
+            FixStatus::kFixed);
+}
+
+TEST(FixFilter, OldAnswersAreForgotten) {
+  FixPolicy policy;
+  policy.window_m = 5.0;
+  FixFilter filter(policy);
+  filter.Update(Answer(kTrue), Odometry(0));
+  // 6 m later the first answer is gone: no fix from the second alone.
+  EXPECT_EQ(filter.Update(Answer(kTrue), Odometry(24)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(Answer(kTrue), Odometry(28)).status, FixStatus::kFixed);
+}
+
+// A fix, then planted wrong answers.
+class FixedFilter : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    filter_.Update(Answer(kTrue), Odometry(0));
+    ASSERT_EQ(filter_.Update(Answer(kTrue), Odometry(5)).status, FixStatus::kFixed);
+  }
+  FixFilter filter_;
+};
+
+TEST_F(FixedFilter, APlantedWrongAnswerIsRejectedAndTheTrackKept) {
+  const RelocalizationUpdate update = filter_.Update(Answer(kWrong, 0.6), Odometry(10));
+  EXPECT_TRUE(update.contradicted);
+  EXPECT_FALSE(update.lost);
+  ASSERT_EQ(update.status, FixStatus::kFixed);
+  const Pose2 expected = kTrue * Odometry(10);
+  EXPECT_NEAR(update.T_world_robot.x, expected.x, 1e-9);
+  EXPECT_NEAR(update.T_world_robot.y, expected.y, 1e-9);
+  // A correct answer then confirms the track.
+  EXPECT_TRUE(filter_.Update(Answer(kTrue), Odometry(15)).confirmed);
+}
+
+TEST_F(FixedFilter, AConfidentContradictionLosesTheFix) {
+  const RelocalizationUpdate update = filter_.Update(Answer(kWrong, 0.95), Odometry(10));
+  EXPECT_TRUE(update.lost);
+  EXPECT_EQ(update.status, FixStatus::kLost);
+  // The contradicting answer is a hypothesis: one more agreeing answer makes a new fix there.
+  const RelocalizationUpdate refix = filter_.Update(Answer(kWrong, 0.5), Odometry(15));
+  EXPECT_TRUE(refix.new_fix);
+  EXPECT_EQ(refix.status, FixStatus::kFixed);
+}
+
+TEST_F(FixedFilter, ContradictionsThatAgreeReplaceTheFix) {
+  filter_.Update(Answer(kWrong, 0.5), Odometry(10));
+  const RelocalizationUpdate update = filter_.Update(Answer(kWrong, 0.5), Odometry(15));
+  EXPECT_TRUE(update.lost);
+  EXPECT_TRUE(update.new_fix);
+  ASSERT_EQ(update.status, FixStatus::kFixed);
+  const Pose2 expected = kWrong * Odometry(15);
+  EXPECT_NEAR(update.T_world_robot.x, expected.x, 1e-9);
+}
+
+TEST_F(FixedFilter, NoConfirmationOverLostAfterLosesTheFix) {
+  const int last_scan_kept = 5 + static_cast<int>(FixPolicy{}.lost_after_m / 0.25);
+  for (int scan = 6; scan <= last_scan_kept; ++scan) {
+    ASSERT_EQ(filter_.Update(std::nullopt, Odometry(scan)).status, FixStatus::kFixed) << scan;
+  }
+  const RelocalizationUpdate update = filter_.Update(std::nullopt, Odometry(last_scan_kept + 1));
+  EXPECT_TRUE(update.lost);
+  EXPECT_EQ(update.status, FixStatus::kLost);
+}
+
+TEST(FixFilter, OneConfirmationFixesAtOnce) {
+  FixPolicy policy;
+  policy.confirmations = 1;
+  FixFilter filter(policy);
+  EXPECT_TRUE(filter.Update(Answer(kTrue), Odometry(0)).new_fix);
+}
+
+TEST(FixFilter, RejectsInvalidPolicies) {
+  FixPolicy policy;
+  policy.confirmations = 0;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+  policy = {};
+  policy.agree_m = -1.0;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+  policy = {};
+  policy.contradiction_confidence = 1.5;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace keyplace
