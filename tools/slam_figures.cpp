@@ -1,6 +1,7 @@
 #include "slam_figures.hpp"
 
-#include <cairo-svg.h>
+#include "figure_file.hpp"
+
 #include <cairo.h>
 
 #include <algorithm>
@@ -13,51 +14,6 @@
 #include <fmt/core.h>
 
 namespace keyplace::cli {
-namespace {
-
-bool IsSvg(const std::string& path) {
-  return path.size() >= 4 && path.compare(path.size() - 4, 4, ".svg") == 0;
-}
-
-// Creates the surface, draws, writes to a temporary file and renames it onto `path`.
-void WriteFigure(const std::string& path, int width_px, int height_px,
-                 const std::function<void(cairo_t*)>& draw) {
-  const std::filesystem::path target(path);
-  const std::string temporary =
-      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
-  const bool svg = IsSvg(path);
-  cairo_surface_t* surface =
-      svg ? cairo_svg_surface_create(temporary.c_str(), width_px, height_px)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px);
-  cairo_t* cr = cairo_create(surface);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
-  draw(cr);
-  cairo_destroy(cr);
-  cairo_status_t status = CAIRO_STATUS_SUCCESS;
-  if (!svg) status = cairo_surface_write_to_png(surface, temporary.c_str());
-  cairo_surface_finish(surface);
-  if (status == CAIRO_STATUS_SUCCESS) status = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) {
-    std::filesystem::remove(temporary);
-    throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, target, error);
-  if (error) throw std::runtime_error(path + ": cannot rename figure: " + error.message());
-}
-
-void Text(cairo_t* cr, double x, double y, const std::string& text, double size = 14.0) {
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, text.c_str());
-}
-
-}  // namespace
-
 void DrawTrajectoryFigure(const std::string& path, const std::string& title,
                           const std::vector<Eigen::Vector2d>& estimated,
                           const std::vector<Eigen::Vector2d>& truth,
@@ -104,10 +60,11 @@ void DrawTrajectoryFigure(const std::string& path, const std::string& title,
     }
     if (!estimated.empty()) dots({estimated.front()}, 0.2, 1.0, 0.2, 9.0);
     if (!loops_used.empty()) dots({loops_used.front()}, 0.2, 1.0, 0.2, 5.0);
-    Text(cr, 10, 25, title);
-    Text(cr, 10, height - 10.0,
-         fmt::format("red: SLAM, green: ground truth, white: loops used; {:.0f} m across", span),
-         12.0);
+    FigureText(cr, 10, 25, title);
+    FigureText(
+        cr, 10, height - 10.0,
+        fmt::format("red: SLAM, green: ground truth, white: loops used; {:.0f} m across", span),
+        12.0);
   });
 }
 
@@ -124,11 +81,11 @@ void DrawHistogramFigure(const std::string& path, const std::string& title,
       cairo_set_source_rgb(cr, 0.25, 0.45, 0.8);
       cairo_rectangle(cr, left + k * (bar_w + 15), bottom - h, bar_w, h);
       cairo_fill(cr);
-      Text(cr, left + k * (bar_w + 15) + 10, bottom + 20, kLabels[k], 13.0);
-      Text(cr, left + k * (bar_w + 15) + 30, bottom - h - 6, std::to_string(counts[k]), 13.0);
+      FigureText(cr, left + k * (bar_w + 15) + 10, bottom + 20, kLabels[k], 13.0);
+      FigureText(cr, left + k * (bar_w + 15) + 30, bottom - h - 6, std::to_string(counts[k]), 13.0);
     }
-    Text(cr, 10, 25, title);
-    Text(cr, left, height - 12.0, "overlap rate of matched submaps (%)", 12.0);
+    FigureText(cr, 10, 25, title);
+    FigureText(cr, left, height - 12.0, "overlap rate of matched submaps (%)", 12.0);
   });
 }
 
@@ -138,7 +95,7 @@ void DrawCurvesFigure(const std::string& path, const std::string& title,
   const int width = static_cast<int>(panel_w * std::max<std::size_t>(1, panels.size()));
   const int height = static_cast<int>(panel_h + top);
   WriteFigure(path, width, height, [&](cairo_t* cr) {
-    Text(cr, 10, 25, title);
+    FigureText(cr, 10, 25, title);
     for (std::size_t p = 0; p < panels.size(); ++p) {
       const CurvePanel& panel = panels[p];
       const double x0 = p * panel_w + 70, x1 = (p + 1) * panel_w - 20;
@@ -183,12 +140,12 @@ void DrawCurvesFigure(const std::string& path, const std::string& title,
           cairo_fill(cr);
         }
       }
-      Text(cr, x0 - 60, y1 - 5, fmt::format("{} (max {:.3g})", panel.y_label, max_y), 12.0);
-      Text(cr, x0, y0 + 35,
-           fmt::format("{}{}: {:.3g} .. {:.3g}", panel.x_label, panel.log_x ? " (log)" : "",
-                       panel.log_x ? std::pow(10.0, min_x) : min_x,
-                       panel.log_x ? std::pow(10.0, max_x) : max_x),
-           12.0);
+      FigureText(cr, x0 - 60, y1 - 5, fmt::format("{} (max {:.3g})", panel.y_label, max_y), 12.0);
+      FigureText(cr, x0, y0 + 35,
+                 fmt::format("{}{}: {:.3g} .. {:.3g}", panel.x_label, panel.log_x ? " (log)" : "",
+                             panel.log_x ? std::pow(10.0, min_x) : min_x,
+                             panel.log_x ? std::pow(10.0, max_x) : max_x),
+                 12.0);
     }
   });
 }

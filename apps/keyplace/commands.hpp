@@ -11,6 +11,7 @@ void RegisterFeaturesCommand(CLI::App& app);
 void RegisterOdometryCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
+void RegisterRelocalizeCommand(CLI::App& app);
 void RegisterSlamCommand(CLI::App& app);
 void RegisterSweepCommand(CLI::App& app);
 void RegisterReportCommand(CLI::App& app);

@@ -21,6 +21,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterOdometryCommand(app);
   keyplace::cli::RegisterMapCommand(app);
   keyplace::cli::RegisterLocalizeCommand(app);
+  keyplace::cli::RegisterRelocalizeCommand(app);
   keyplace::cli::RegisterSlamCommand(app);
   keyplace::cli::RegisterSweepCommand(app);
   keyplace::cli::RegisterReportCommand(app);

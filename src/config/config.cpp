@@ -85,7 +85,11 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
         .Double("local_relation_max_dt_s", &C::local_relation_max_dt_s, "s",
                 "relations with |t_b - t_a| below this are local, the others loop")
         .Int("truth_max_gap_scans", &C::truth_max_gap_scans, "",
-             "slam loops are checked when their origins are this close to a corrected scan");
+             "slam loops are checked when their origins are this close to a corrected scan")
+        .Double("give_up_m", &C::give_up_m, "m",
+                "relocalize: a start without a fix is given up after this odometry distance")
+        .Double("follow_m", &C::follow_m, "m",
+                "relocalize: fixes are checked over this distance after the first one");
     return table;
   }();
   return fields;
@@ -97,6 +101,10 @@ void Validate(const EvaluationConfig& config) {
   }
   if (config.truth_max_gap_scans < 0) {
     throw std::invalid_argument("EvaluationConfig.truth_max_gap_scans must be >= 0");
+  }
+  if (!(config.give_up_m > 0.0) || !(config.follow_m >= 0.0)) {
+    throw std::invalid_argument(
+        "EvaluationConfig.give_up_m must be positive and EvaluationConfig.follow_m >= 0");
   }
 }
 

@@ -11,6 +11,10 @@ struct EvaluationConfig {
   // this many scans (processing order) from a scan with a corrected pose; FR101 has one corrected
   // scan per 16 raw ones.
   int truth_max_gap_scans = 50;
+  // keyplace relocalize: a start without a fix is given up after this odometry distance, and
+  // after its first fix the fixes are checked over this further distance.
+  double give_up_m = 50.0;
+  double follow_m = 20.0;
 };
 
 /// Throws std::invalid_argument naming the first invalid field.

@@ -1,0 +1,152 @@
+// keyplace relocalize: the kidnapped-robot benchmark (eval/relocalization.hpp). From --starts
+// starts spread over the query log a Relocalizer that knows nothing is fed scans and odometry
+// until it declares a fix or gives up; every fix it reports is checked against the truth.
+
+#include <chrono>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "config_options.hpp"
+#include "io/file_fingerprint.hpp"
+#include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/eval/relocalization.hpp"
+#include "keyplace/store/map_file.hpp"
+#include "relocalize_output.hpp"
+
+namespace keyplace::cli {
+namespace {
+
+struct RelocalizeOptions {
+  std::string map_path;
+  std::string log_path;
+  std::string poses = "corrected";
+  std::string truth_path;
+  std::string index_path;
+  std::string scans = ":";
+  std::string self_match = "shared-scan";
+  std::string json_path;
+  std::string tsv_path;
+  std::string figure_path;
+  ConfigOptions config;
+  int starts = 50;
+  bool skip_bad_lines = false;
+};
+
+RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config& config,
+                                       bool query_log_is_map_log) {
+  RelocalizationOptions options;
+  options.starts = o.starts;
+  options.give_up_m = config.evaluation.give_up_m;
+  options.follow_m = config.evaluation.follow_m;
+  // Scan indices of another recording say nothing about this one: no self-match rule there.
+  options.exclude_shared_scans = o.self_match == "shared-scan" && query_log_is_map_log;
+  return options;
+}
+
+void RunRelocalize(const RelocalizeOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
+  const Config config = ResolveConfig(options.config);
+  const GlobalMap map = LoadMap(options.map_path);
+
+  LogInputOptions input_options;
+  input_options.reading.skip_bad_lines = options.skip_bad_lines;
+  input_options.poses = ParsePoseSource(options.poses);
+  input_options.odometry = config.odometry;
+  input_options.features = config.features;
+  // The log's end is not known yet: PrepareLogInputs cuts an open range at it.
+  const ScanRange range = ParseScanRange(options.scans, std::numeric_limits<std::size_t>::max());
+  input_options.first_scan = range.begin;
+  input_options.end_scan = range.end;
+  const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
+  PrintLogWarnings(inputs.log);
+  const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
+                                            options.truth_path, options.index_path);
+
+  RelocalizeReport report;
+  report.map_path = options.map_path;
+  report.log_path = options.log_path;
+  report.first_scan = inputs.first_scan;
+  report.end_scan = inputs.first_scan + inputs.log.scans.size();
+  report.pose_source = inputs.pose_source;
+  report.query_log_is_map_log = map.source_hash == FileFingerprint(truth.truth_log);  // TEMP
+  report.options = BenchmarkOptions(options, config, report.query_log_is_map_log);
+  report.seconds_keypoints_per_scan =
+      inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());
+
+  Progress progress("starts", static_cast<std::size_t>(options.starts));
+  report.records = RunRelocalization(map, inputs, truth, ToLocalizerConfig(config), report.options,
+                                     [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+  report.summary = SummarizeRelocalization(report.records, report.options);
+  report.seconds_total = SecondsSince(start);
+  PrintRelocalizeReport(report, map);
+  if (!options.tsv_path.empty()) WriteStartsTsv(options.tsv_path, report.records);
+  if (!options.figure_path.empty()) {
+    DrawRelocalization(options.figure_path, report, map, inputs, truth);
+  }
+  if (!options.json_path.empty()) {
+    nlohmann::json json = RelocalizeJson(report);
+    json["config"] = ConfigJson(config);
+    WriteJson(options.json_path, json);
+  }
+}
+
+}  // namespace
+
+void RegisterRelocalizeCommand(CLI::App& app) {
+  auto options = std::make_shared<RelocalizeOptions>();
+  CLI::App* command = app.add_subcommand(
+      "relocalize",
+      "The kidnapped-robot benchmark: from --starts starts spread over the query log the "
+      "localizer, knowing nothing, is fed scans and odometry until two answers agree on a fix "
+      "(or it gives up after evaluation.give_up_m of travel); it then runs evaluation.follow_m "
+      "further and every fix it reports is checked against the truth (0.5 m, 10 deg).");
+  command->add_option("--map", options->map_path, "Map file (.kpm)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--log", options->log_path, "Query log (corrected or raw)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--poses", options->poses,
+                   "Odometry fed to the localizer: corrected (the log's), icp (scan matching on "
+                   "odometry) or odometry")
+      ->check(CLI::IsMember({"corrected", "icp", "odometry"}))
+      ->capture_default_str();
+  command
+      ->add_option("--truth", options->truth_path,
+                   "Corrected log giving the ground truth of a raw query log")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--index", options->index_path,
+                   "raw_index<TAB>corrected_index file relating --log to --truth")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--scans", options->scans,
+                   "Query scans A:B of the log (e.g. 700: when the map was built from 0:700)")
+      ->capture_default_str();
+  command->add_option("--starts", options->starts, "Number of starts")->capture_default_str();
+  command
+      ->add_option("--self-match", options->self_match,
+                   "shared-scan: on the map's own log, never match a map submap sharing a scan "
+                   "with the current query (true revisits only); none: allow it. Another log "
+                   "than the map's is never excluded")
+      ->check(CLI::IsMember({"shared-scan", "none"}))
+      ->capture_default_str();
+  AddConfigOptions(command, options->config);
+  command->add_option("--json", options->json_path, "Write the summary as JSON to FILE");
+  command->add_option("--tsv", options->tsv_path, "Write one TSV row per start to FILE");
+  command->add_option("--figure", options->figure_path,
+                      "Draw the starts, paths and fixes (.png or .svg)");
+  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
+  command->callback([options] { RunRelocalize(*options); });
+}
+
+}  // namespace keyplace::cli

@@ -1,0 +1,131 @@
+#include "relocalize_output.hpp"
+
+#include <filesystem>
+
+#include <fmt/core.h>
+#include <fmt/ostream.h>
+
+#include "io/atomic_file.hpp"
+#include "relocalization_figure.hpp"
+
+namespace keyplace::cli {
+
+void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
+  const RelocalizationSummary& s = r.summary;
+  const RelocalizationOptions& o = r.options;
+  fmt::print("map          {} ({} submaps, built from {})\n", r.map_path, map.submaps.size(),
+             map.source_log);
+  fmt::print("log          {} (scans {}:{}, {} poses as odometry)\n", r.log_path, r.first_scan,
+             r.end_scan, ToString(r.pose_source));
+  fmt::print("protocol     {}\n",
+             !r.query_log_is_map_log ? "another recording than the map's: nothing excluded"
+             : o.exclude_shared_scans
+                 ? "the map's own log: submaps sharing a scan with the query are excluded"
+                 : "the map's own log, nothing excluded (self-matches allowed)");
+  fmt::print("starts       {} ({} pass a map scan within {} m / {} deg before {} m)\n", s.starts,
+             s.starts_with_revisit, o.revisit_m, o.revisit_deg, o.give_up_m);
+  fmt::print("fixed        {:.3f} of starts with a revisit ({}/{}); {} starts in all\n",
+             s.fixed_fraction, s.fixed_with_revisit, s.starts_with_revisit, s.fixed);
+  fmt::print("to first fix median {:.2f} m, 90th percentile {:.2f} m, median {:.0f} scans\n",
+             s.distance_to_fix_median_m, s.distance_to_fix_p90_m, s.scans_to_fix_median);
+  fmt::print("fixes        {} checked over {} m after each first fix, {} wrong (rate {:.4f}); "
+             "{} wrong first fixes\n",
+             s.fixes, o.follow_m, s.wrong_fixes, s.wrong_fix_rate, s.wrong_first_fixes);
+  fmt::print("wrong fixes  {} (highest confidence {:.3f}, confident = {})\n",
+             s.wrong_fix_confident ? "one was reported as confident" : "none was confident",
+             s.wrong_fix_confidence_max, o.confident);
+  fmt::print("lost         {} signals: {} on a correct track, {} on a wrong one\n", s.lost_signals,
+             s.lost_on_correct_track, s.lost_on_wrong_track);
+  fmt::print("update       mean {:.2f} ms, max {:.1f} ms per AddScan with keypoints given; FLIRT "
+             "{:.2f} ms per scan\n",
+             1e3 * s.update_seconds_mean, 1e3 * s.update_seconds_max,
+             1e3 * r.seconds_keypoints_per_scan);
+  fmt::print("time         {:.1f} s\n", r.seconds_total);
+}
+
+void WriteStartsTsv(const std::string& path, const std::vector<StartRecord>& records) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "start_scan\tend_scan\trevisit\tfixed\tscans_to_fix\tdistance_to_fix_m\t"
+           "first_fix_correct\tanswers\tanswers_accepted\tfixes\twrong_fixes\tlost\t"
+           "lost_on_correct_track\tlost_on_wrong_track\tupdate_seconds_mean\t"
+           "update_seconds_max\n";
+    for (const StartRecord& r : records) {
+      fmt::print(out, "{}\t{}\t{:d}\t{:d}\t{}\t{:.3f}\t{:d}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\n",
+                 r.start_scan, r.end_scan, r.revisit, r.fixed, r.scans_to_fix,
+                 r.distance_to_fix_m, r.first_fix_correct, r.answers, r.answers_accepted,
+                 r.fixes.size(), r.wrong_fixes, r.lost, r.lost_on_correct_track,
+                 r.lost_on_wrong_track, r.update_seconds_mean, r.update_seconds_max);
+    }
+  });
+}
+
+nlohmann::json RelocalizeJson(const RelocalizeReport& r) {
+  const RelocalizationSummary& s = r.summary;
+  const RelocalizationOptions& o = r.options;
+  nlohmann::json json;
+  json["map"] = r.map_path;
+  json["log"] = r.log_path;
+  json["scans"] = {r.first_scan, r.end_scan};
+  json["pose_source"] = ToString(r.pose_source);
+  json["query_log_is_map_log"] = r.query_log_is_map_log;
+  json["exclude_shared_scans"] = o.exclude_shared_scans;
+  json["give_up_m"] = o.give_up_m;
+  json["follow_m"] = o.follow_m;
+  json["starts"] = s.starts;
+  json["starts_with_revisit"] = s.starts_with_revisit;
+  json["fixed"] = s.fixed;
+  json["fixed_with_revisit"] = s.fixed_with_revisit;
+  json["fixed_fraction"] = s.fixed_fraction;
+  json["fixes"] = s.fixes;
+  json["wrong_fixes"] = s.wrong_fixes;
+  json["wrong_fix_rate"] = s.wrong_fix_rate;
+  json["wrong_first_fixes"] = s.wrong_first_fixes;
+  json["wrong_fix_confident"] = s.wrong_fix_confident;
+  json["wrong_fix_confidence_max"] = s.wrong_fix_confidence_max;
+  json["distance_to_fix_median_m"] = s.distance_to_fix_median_m;
+  json["distance_to_fix_p90_m"] = s.distance_to_fix_p90_m;
+  json["scans_to_fix_median"] = s.scans_to_fix_median;
+  json["update_seconds_mean"] = s.update_seconds_mean;
+  json["update_seconds_max"] = s.update_seconds_max;
+  json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan;
+  json["lost_signals"] = s.lost_signals;
+  json["lost_on_correct_track"] = s.lost_on_correct_track;
+  json["lost_on_wrong_track"] = s.lost_on_wrong_track;
+  json["seconds_total"] = r.seconds_total;
+  return json;
+}
+
+void DrawRelocalization(const std::string& path, const RelocalizeReport& report,
+                        const GlobalMap& map, const LogInputs& inputs, const GroundTruth& truth) {
+  std::vector<Eigen::Vector2d> map_positions;
+  for (const Submap& submap : map.submaps) {
+    for (const Pose2& pose : submap.poses) map_positions.push_back(pose.translation());
+  }
+  std::vector<StartDrawing> starts;
+  for (const StartRecord& r : report.records) {
+    StartDrawing drawing;
+    const int last = r.fixed ? r.start_scan + r.scans_to_fix : r.end_scan;
+    for (int k = r.start_scan; k < last && k < static_cast<int>(inputs.log.scans.size()); ++k) {
+      if (truth.Has(static_cast<std::size_t>(k))) {
+        drawing.path_to_fix.push_back(truth.Pose(static_cast<std::size_t>(k)).translation());
+      }
+    }
+    for (const FixEvent& fix : r.fixes) {
+      if (!fix.correct) {
+        drawing.wrong_fixes.push_back(fix.T_world_robot.translation());
+      } else if (fix.first) {
+        drawing.correct_fixes.push_back(fix.T_world_robot.translation());
+      }
+    }
+    starts.push_back(std::move(drawing));
+  }
+  const RelocalizationSummary& s = report.summary;
+  DrawRelocalizationFigure(
+      path,
+      fmt::format("{}: {} starts, {:.0f} % fixed, median {:.1f} m to fix, {} wrong of {} fixes",
+                  std::filesystem::path(report.log_path).filename().string(), s.starts,
+                  100.0 * s.fixed_fraction, s.distance_to_fix_median_m, s.wrong_fixes, s.fixes),
+      map_positions, starts);
+}
+
+}  // namespace keyplace::cli

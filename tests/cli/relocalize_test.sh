@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# keyplace relocalize end to end on the bundled corrected FR079 log: the kidnapped-robot benchmark
+# under protocol (a) (the map's own log, submaps sharing a scan with the query excluded) and (b)
+# (time split: the map from scans 0:700, the starts from 700:), its outputs, the JSON keys scripts
+# read, and clear errors. Usage: relocalize_test.sh KEYPLACE_BINARY SOURCE_DIR
+set -uo pipefail
+keyplace=$1
+source_dir=$2
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
+log="$source_dir/data/fr079-corrected.log.gz"
+
+check "relocalize --help" "$keyplace" relocalize --help
+check "map" "$keyplace" map "$log" --out "$work/map.kpm"
+check "relocalize (a)" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" --starts 12 \
+  --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png"
+check "figure" test -s "$work/a.png"
+check "TSV: one row per start" test "$(($(wc -l <"$work/a.tsv") - 1))" = 12
+check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tfixed\tscans_to_fix\tdistance_to_fix_m' \
+  "$work/a.tsv"
+check "JSON (a)" /usr/bin/python3 -c "
+import json,sys
+j = json.load(open(sys.argv[1]))
+for key in ['starts', 'starts_with_revisit', 'fixed_fraction', 'wrong_fix_rate',
+            'distance_to_fix_median_m', 'distance_to_fix_p90_m', 'update_seconds_mean',
+            'update_seconds_max', 'lost_signals']:
+    assert key in j, key
+assert j['starts'] == 12, j['starts']
+assert j['query_log_is_map_log'] and j['exclude_shared_scans'], j
+# FR079 is revisited all over: most starts pass a map scan, and nearly all of those get a fix.
+assert j['starts_with_revisit'] >= 8, j['starts_with_revisit']
+assert j['fixed_fraction'] >= 0.8, j['fixed_fraction']
+assert j['wrong_fix_rate'] <= 0.05, j['wrong_fix_rate']
+assert 0 < j['distance_to_fix_median_m'] <= j['distance_to_fix_p90_m'] < 50, j
+assert 0 < j['update_seconds_mean'] <= j['update_seconds_max'], j
+" "$work/a.json"
+
+check "map of scans 0:700" "$keyplace" map "$log" --scans 0:700 --out "$work/first.kpm"
+check "relocalize (b)" "$keyplace" relocalize --map "$work/first.kpm" --log "$log" \
+  --scans 700: --starts 8 --json "$work/b.json" --tsv "$work/b.tsv"
+check "JSON (b)" /usr/bin/python3 -c "
+import json,sys
+j = json.load(open(sys.argv[1]))
+assert j['scans'][0] == 700, j['scans']
+assert j['starts'] == 8, j['starts']
+assert j['wrong_fix_rate'] <= 0.05, j['wrong_fix_rate']
+" "$work/b.json"
+check "starts in 700:" /usr/bin/python3 -c "
+import csv,sys
+rows = list(csv.DictReader(open(sys.argv[1]), delimiter='\t'))
+assert all(int(r['start_scan']) >= 0 for r in rows)
+assert len(rows) == 8
+" "$work/b.tsv"
+
+fails_with "no starts" "--starts" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
+  --starts 0
+fails_with "bad range" "--scans" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
+  --scans 5:x
+fails_with "bad config key" "localization.fix.nope" "$keyplace" relocalize --map "$work/map.kpm" \
+  --log "$log" --set localization.fix.nope=1
+fails_with "bad policy" "confirmations" "$keyplace" relocalize --map "$work/map.kpm" \
+  --log "$log" --set localization.fix.confirmations=0
+echo '{"kept": true}' >"$work/keep.json"
+fails_with "bad map" "not.kpm" "$keyplace" relocalize --map "$work/not.kpm" --log "$log" \
+  --json "$work/keep.json"
+check "existing JSON kept" grep -q kept "$work/keep.json"
+
+finish relocalize
