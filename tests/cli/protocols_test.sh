@@ -61,7 +61,7 @@ assert len(rows) == 10 and [int(r['count']) for r in rows] == [b['count'] for b 
 
 # The same scans as the map, same file: the paper's rule excludes each query's own submap.
 check "localize the map's own scans" "$keyplace" localize --map "$work/first.kpm" --log "$log" \
-  --scans 0:700 --n-pos 10 --json "$work/own.json" --queries "$work/own.tsv"
+  --scans 0:350 --n-pos 10 --json "$work/own.json" --queries "$work/own.tsv"
 check "own scans are excluded" python3 -c "
 import csv,sys
 rows=list(csv.DictReader(open(sys.argv[1]), delimiter='\t'))
@@ -70,7 +70,7 @@ assert sum(int(r['places_excluded']) for r in rows) > 0, rows" "$work/own.tsv"
 # (d) Another file (the same run written out as plain text: other bytes, another name): no
 # self-match exclusion, said on stdout; the own submaps are then fair answers.
 gzip -dc "$log" >"$work/tuesday.log"
-if "$keyplace" localize --map "$work/first.kpm" --log "$work/tuesday.log" --scans 0:700 \
+if "$keyplace" localize --map "$work/first.kpm" --log "$work/tuesday.log" --scans 0:350 \
   --n-pos 10 --json "$work/other.json" --queries "$work/other.tsv" >"$work/other.out" \
   2>"$work/other.err"; then
   ok
