@@ -64,10 +64,12 @@ void SubmapColour(cairo_t* cr, int id) {
 
 // World points of the scans that went into submaps (every other beam is plenty to look at).
 std::vector<Eigen::Vector2d> MapScanPoints(const GlobalMap& map, const std::vector<LogScan>& scans,
-                                           const std::vector<Pose2>& poses) {
+                                           const std::vector<Pose2>& poses,
+                                           std::size_t first_scan) {
   std::vector<Eigen::Vector2d> points;
   for (const Submap& submap : map.submaps) {
-    for (const int index : submap.scan_indices) {
+    for (const int file_index : submap.scan_indices) {
+      const int index = file_index - static_cast<int>(first_scan);
       if (index < 0 || static_cast<std::size_t>(index) >= scans.size() ||
           static_cast<std::size_t>(index) >= poses.size()) {
         continue;
@@ -232,7 +234,7 @@ void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vec
   if (!svg && !EndsWith(path, ".png")) {
     throw std::invalid_argument(path + ": figure file name must end in .png or .svg");
   }
-  const std::vector<Eigen::Vector2d> points = MapScanPoints(map, scans, poses);
+  const std::vector<Eigen::Vector2d> points = MapScanPoints(map, scans, poses, options.first_scan);
   const MapLayout layout = FitMap(MapBounds(map, points), options);
 
   const std::filesystem::path target(path);

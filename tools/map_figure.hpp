@@ -1,6 +1,7 @@
 #pragma once
 // Pictures of a map: registered scan points, stable keypoints and submap origins (cairo).
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@ struct MapFigureOptions {
   std::string title;
   double pixels_per_m = 20.0;  // reduced automatically so the larger side fits max_side_px
   int max_side_px = 2400;
+  std::size_t first_scan = 0;  // file scan index of scans[0] (map scan indices are file indices)
 };
 
 /// Draws the map; the format follows the extension of `path` (.png or .svg). `poses` are the

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -53,6 +54,13 @@ ScanRange ParseScanRange(const std::string& text, std::size_t count) {
     throw std::invalid_argument("--scans '" + text + "': end is before begin");
   }
   return range;
+}
+
+void ApplyScanRange(const std::string& text, LogInputOptions& options) {
+  if (text.empty()) return;
+  const ScanRange range = ParseScanRange(text, std::numeric_limits<std::size_t>::max());
+  options.first_scan = range.begin;
+  options.end_scan = range.end;
 }
 
 Progress::Progress(std::string label, std::size_t total)

@@ -38,6 +38,10 @@ struct ScanRange {
 };
 ScanRange ParseScanRange(const std::string& text, std::size_t count);
 
+/// --scans A:B as the scans [A, B) of the file that PrepareLogInputs keeps (clamped to the log
+/// there); nothing when `text` is empty.
+void ApplyScanRange(const std::string& text, LogInputOptions& options);
+
 /// A progress line on stderr ("label  123/456  27 %  ETA 12 s"), at most a few times a second,
 /// and only when stderr is a terminal or KEYPLACE_PROGRESS=1.
 class Progress {

@@ -36,6 +36,8 @@ struct LocalizeOptions {
   std::string curve_path;
   std::string baseline;
   std::string rank_by;
+  std::string scans;
+  std::string reliability_path;
   ConfigOptions config;
   std::optional<int> mu;
   std::optional<double> gamma_min;
@@ -82,7 +84,7 @@ void RunLocalize(const LocalizeOptions& options) {
       !options.rank_by.empty()
           ? options.rank_by
           : (baseline ? "consensus" : (options.config.preset == "paper" ? "gamma" : "confidence")));
-  const SelfMatchRule rule =
+  SelfMatchRule rule =
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
 
   LogInputOptions input_options;
@@ -90,23 +92,37 @@ void RunLocalize(const LocalizeOptions& options) {
   input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
+  ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   PrintLogWarnings(inputs.log);
-  const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
-                                            options.truth_path, options.index_path);
+  const GroundTruth truth =
+      LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans, options.truth_path,
+                      options.index_path, inputs.source_hash);
   const std::string map_log_path =
       options.truth_path.empty() ? options.log_path : options.truth_path;
   const std::vector<int> starts = QueryStarts(truth, options.n_pos);
 
   std::vector<Place> places;
   std::vector<LocalizationQuery> queries;
+  std::vector<Submap> map_scans;  // where a query is revisitable
   std::string map_description;
+  bool truth_is_map_log = true;  // the TIP-FLIRT places are scans of the truth log
   if (!baseline) {
-    const GlobalMap map = LoadMap(options.map_path);
-    WarnAboutMapSource(options.map_path, map, map_log_path);
+    GlobalMap map = LoadMap(options.map_path);
+    truth_is_map_log = TruthIsMapLog(map, truth);
+    WarnAboutMapSource(options.map_path, map, map_log_path, truth_is_map_log);
+    if (!truth_is_map_log) {
+      // Scan indices of two files name different scans: no map place is a self-match.
+      rule = SelfMatchRule::kNone;
+      fmt::print(
+          "self-match         none: the query log is another recording than the map's {} (no "
+          "self-match exclusion)\n",
+          map.source_log);
+    }
     places = PlacesFromMap(map);
     map_description = fmt::format("{} ({} submaps, {} keypoints)", options.map_path,
                                   map.submaps.size(), map.KeypointCount());
+    map_scans = std::move(map.submaps);
     Progress progress("query submaps", starts.size());
     queries = BuildSubmapQueries(inputs, truth, map.config, starts, config.place.query_keypoints,
                                  [&](std::size_t done, std::size_t) { progress.Update(done); });
@@ -114,9 +130,13 @@ void RunLocalize(const LocalizeOptions& options) {
   } else {
     LogInputOptions map_options = input_options;
     map_options.poses = PoseSource::kCorrected;
+    // --scans cuts the query log; the places of a --truth log are all of its scans.
+    map_options.first_scan = 0;
+    map_options.end_scan = LogInputOptions{}.end_scan;
     const LogInputs map_log =
         options.truth_path.empty() ? inputs : PrepareLogInputs(options.truth_path, map_options);
     places = ScanPlaces(map_log);
+    map_scans = ScanPlacesAsSubmaps(places);
     map_description =
         fmt::format("TIP-FLIRT: {} scans of {} as places", places.size(), map_log_path);
     queries = BuildScanQueries(inputs, truth, starts);
@@ -124,9 +144,10 @@ void RunLocalize(const LocalizeOptions& options) {
   const double preparation_seconds = SecondsSince(start);
   const PlaceRecognizer recognizer(std::move(places), config.place);
   Progress progress("localize", queries.size());
-  const std::vector<LocalizationRecord> records = EvaluateQueries(
+  std::vector<LocalizationRecord> records = EvaluateQueries(
       queries, recognizer, rule, [&](std::size_t done, std::size_t) { progress.Update(done); });
   progress.Finish();
+  MarkRevisitable(queries, map_scans, rule, config.evaluation, records);
 
   LocalizeReport report;
   report.log_path = options.log_path;
@@ -137,12 +158,21 @@ void RunLocalize(const LocalizeOptions& options) {
   report.preset = options.config.preset;
   report.baseline = baseline;
   report.exclude_shared_scans = options.exclude_shared_scans;
+  report.self_match = rule;
+  report.truth_is_map_log = truth_is_map_log;
+  report.first_scan = inputs.first_scan;
+  report.file_scans = inputs.file_scans;
+  report.evaluation = config.evaluation;
   report.place = config.place;
   report.summary = Summarize(records, rank_by);
   report.preparation_seconds = preparation_seconds;
   PrintLocalizeReport(report);
-  if (!options.queries_path.empty()) WriteQueriesTsv(options.queries_path, records);
+  if (!options.queries_path.empty())
+    WriteQueriesTsv(options.queries_path, records, inputs.first_scan);
   if (!options.curve_path.empty()) WriteCurveTsv(options.curve_path, report.summary.curve);
+  if (!options.reliability_path.empty()) {
+    WriteReliabilityTsv(options.reliability_path, report.summary.reliability);
+  }
   if (!options.json_path.empty()) {
     nlohmann::json json = LocalizeJson(report, records);
     json["map"] = baseline ? "" : options.map_path;
@@ -162,8 +192,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "localize",
       "Global localization against a map (paper Algorithm 4): query submaps from n_pos equally "
-      "spaced starts, place recognition, precision/recall, P_GL/P_CL, or the TIP-FLIRT "
-      "single-scan baseline.");
+      "spaced starts, place recognition, precision/recall (also over the revisitable queries: "
+      "a map scan within evaluation.revisit_radius_m / revisit_angle_deg), P_GL/P_CL, the "
+      "confidence's reliability diagram, or the TIP-FLIRT single-scan baseline.");
   command->add_option("--map", options->map_path, "Map file (.kpm) built from the corrected log")
       ->check(CLI::ExistingFile);
   command->add_option("--log", options->log_path, "Query log (corrected or raw)")
@@ -197,9 +228,14 @@ void RegisterLocalizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"dense", "kdtree", "none"}));
   AddConfigOptions(command, options->config);
   command->add_option("--n-pos", options->n_pos, "Number of queries")->capture_default_str();
+  command->add_option("--scans", options->scans,
+                      "Queries from the scans C:D of --log only (e.g. 700: after a map of "
+                      "--scans 0:700, the time split); scan indices stay those of the whole file");
   command->add_flag("--exclude-shared-scans", options->exclude_shared_scans,
                     "Skip every map submap sharing a scan with the query (default: only submaps "
-                    "built from exactly the query's scans, the paper's rule)");
+                    "built from exactly the query's scans, the paper's rule). Either rule applies "
+                    "only when the truth log is the map's own log (same file fingerprint); "
+                    "queries from another recording exclude nothing");
   command
       ->add_option("--baseline", options->baseline,
                    "tip-flirt: every scan of the corrected log is a place, each query one scan, "
@@ -214,6 +250,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--json", options->json_path, "Write the figures as JSON to FILE");
   command->add_option("--queries", options->queries_path, "Write one TSV row per query to FILE");
   command->add_option("--curve", options->curve_path, "Write the precision-recall curve (TSV)");
+  command->add_option("--reliability", options->reliability_path,
+                      "Write the reliability diagram (TSV): accepted answers in 10 confidence "
+                      "bins, mean confidence and observed precision per bin");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   command->callback([options] { RunLocalize(*options); });
 }

@@ -12,6 +12,30 @@
 namespace keyplace::cli {
 namespace {
 
+nlohmann::json ReliabilityJson(const std::vector<ReliabilityBin>& bins) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const ReliabilityBin& b : bins) {
+    json.push_back({{"bin_low", b.bin_low},
+                    {"bin_high", b.bin_high},
+                    {"count", b.count},
+                    {"confidence_mean", b.confidence_mean},
+                    {"precision", b.precision}});
+  }
+  return json;
+}
+
+std::string SelfMatchName(SelfMatchRule rule) {
+  switch (rule) {
+    case SelfMatchRule::kNone:
+      return "none";
+    case SelfMatchRule::kSameScans:
+      return "same_scans";
+    case SelfMatchRule::kSharedScan:
+      return "shared_scan";
+  }
+  return "?";
+}
+
 nlohmann::json CurveJson(const std::vector<PrPoint>& curve) {
   nlohmann::json points = nlohmann::json::array();
   for (const PrPoint& p : curve) {
@@ -43,25 +67,33 @@ const PaperPglPcl* PaperX(const LocalizeReport& r) {
 }  // namespace
 
 void WarnAboutMapSource(const std::string& map_path, const GlobalMap& map,
-                        const std::string& truth_log_path) {
+                        const std::string& truth_log_path, bool truth_is_map_log) {
   if (map.pose_source != "corrected") {
     fmt::print(stderr,
                "keyplace: warning: {} was built from {} poses; the truth is in the corrected "
                "frame\n",
                map_path, map.pose_source);
   }
+  // Another file name is a deliberate choice (protocol (d)), which localize reports on stdout;
+  // the same name with other contents is more likely a mistake.
   const std::string expected = std::filesystem::path(truth_log_path).filename().string();
-  if (map.source_log != expected) {
-    fmt::print(stderr, "keyplace: warning: {} was built from {}, the truth comes from {}\n",
-               map_path, map.source_log, expected);
+  if (map.source_log == expected && !truth_is_map_log) {
+    fmt::print(stderr,
+               "keyplace: warning: {} was built from a file named {} with other contents ({}) "
+               "than {}: the queries count as another recording\n",
+               map_path, map.source_log, map.source_hash, truth_log_path);
   }
 }
 
 void PrintLocalizeReport(const LocalizeReport& r) {
   const LocalizationSummary& s = r.summary;
   const std::string dataset = DatasetOf(r.log_path);
-  fmt::print("log                {} ({} scans, {} poses), {} queries of {} requested\n", r.log_path,
-             r.log_scans, ToString(r.pose_source), s.n_pos, r.n_requested);
+  const std::string scans = r.first_scan == 0 && r.log_scans == r.file_scans
+                                ? fmt::format("{} scans", r.log_scans)
+                                : fmt::format("scans {}:{} of {}", r.first_scan,
+                                              r.first_scan + r.log_scans, r.file_scans);
+  fmt::print("log                {} ({}, {} poses), {} queries of {} requested\n", r.log_path,
+             scans, ToString(r.pose_source), s.n_pos, r.n_requested);
   fmt::print("map                {}\n", r.map_description);
   // Single-scan baseline queries carry no all-scan keypoints, so min_gamma applies to them.
   const bool all_scan_queries =
@@ -71,10 +103,17 @@ void PrintLocalizeReport(const LocalizeReport& r) {
              all_scan_queries
                  ? fmt::format("{} (all-scan query keypoints)", r.place.min_gamma_all_scans)
                  : fmt::format("{}", r.place.min_gamma),
-             r.place.double_match_m, r.exclude_shared_scans ? "shared-scan" : "same-scans");
+             r.place.double_match_m,
+             r.self_match == SelfMatchRule::kNone
+                 ? "none"
+                 : (r.exclude_shared_scans ? "shared-scan" : "same-scans"));
   fmt::print("accepted           {} (verified {}, ambiguous {} of which {} wrong)\n", s.n_acc,
              s.n_verified, s.n_ambiguous, s.n_ambiguous_wrong);
   fmt::print("correct            {}\n", s.n_cor);
+  fmt::print(
+      "revisitable        {} (a map scan within {} m, {} deg of the true pose), recall {:.3f}\n",
+      s.n_revisitable, r.evaluation.revisit_radius_m, r.evaluation.revisit_angle_deg,
+      s.recall_revisitable);
   fmt::print("P_GL / P_CL        {:.3f} / {:.3f} (ranked by {})\n", s.p_gl, s.p_cl,
              ToString(s.rank_by));
   fmt::print(
@@ -97,21 +136,25 @@ void PrintLocalizeReport(const LocalizeReport& r) {
   }
 }
 
-void WriteQueriesTsv(const std::string& path, const std::vector<LocalizationRecord>& records) {
+void WriteQueriesTsv(const std::string& path, const std::vector<LocalizationRecord>& records,
+                     std::size_t first_scan) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "start_scan\tevaluated_scan\tscans\tverified\taccepted\tambiguous\tcorrect\t"
            "matched_submap\test_x\test_y\test_theta\ttrue_x\ttrue_y\ttrue_theta\tconsensus\t"
-           "gamma\tscore\tsecond_score\tconfidence\tcandidates\tseconds\treference_coverage\n";
+           "gamma\tscore\tsecond_score\tconfidence\tcandidates\tseconds\treference_coverage\t"
+           "places_excluded\trevisitable\n";
     for (const LocalizationRecord& r : records) {
       const PlaceMatch& m = r.match;
-      fmt::print(out,
-                 "{}\t{}\t{}\t{:d}\t{:d}\t{:d}\t{:d}\t{}\t{:.4f}\t{:.4f}\t{:.5f}\t{:.4f}\t"
-                 "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\t{:.4f}\n",
-                 r.start_scan, r.evaluated_scan, r.scans, m.verified, m.found, m.ambiguous,
-                 r.correct, m.place_id, m.estimated_pose.x, m.estimated_pose.y,
-                 m.estimated_pose.theta, r.truth.x, r.truth.y, r.truth.theta, m.consensus, m.gamma,
-                 m.score, m.second_score, m.confidence, m.candidates, m.seconds,
-                 m.reference_coverage);
+      fmt::print(
+          out,
+          "{}\t{}\t{}\t{:d}\t{:d}\t{:d}\t{:d}\t{}\t{:.4f}\t{:.4f}\t{:.5f}\t{:.4f}\t"
+          "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\t{:.4f}\t{}\t{:d}\n",
+          first_scan + static_cast<std::size_t>(r.start_scan),
+          first_scan + static_cast<std::size_t>(r.evaluated_scan), r.scans, m.verified, m.found,
+          m.ambiguous, r.correct, m.place_id, m.estimated_pose.x, m.estimated_pose.y,
+          m.estimated_pose.theta, r.truth.x, r.truth.y, r.truth.theta, m.consensus, m.gamma,
+          m.score, m.second_score, m.confidence, m.candidates, m.seconds, m.reference_coverage,
+          m.places_excluded, r.revisitable);
     }
   });
 }
@@ -126,6 +169,16 @@ void WriteCurveTsv(const std::string& path, const std::vector<PrPoint>& curve) {
   });
 }
 
+void WriteReliabilityTsv(const std::string& path, const std::vector<ReliabilityBin>& bins) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "bin_low\tbin_high\tcount\tconfidence_mean\tprecision\n";
+    for (const ReliabilityBin& b : bins) {
+      fmt::print(out, "{:.2f}\t{:.2f}\t{}\t{:.6f}\t{:.6f}\n", b.bin_low, b.bin_high, b.count,
+                 b.confidence_mean, b.precision);
+    }
+  });
+}
+
 nlohmann::json LocalizeJson(const LocalizeReport& r,
                             const std::vector<LocalizationRecord>& records) {
   const LocalizationSummary& s = r.summary;
@@ -134,7 +187,10 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["dataset"] = DatasetOf(r.log_path);
   json["pose_source"] = ToString(r.pose_source);
   json["preset"] = r.preset;
-  json["self_match"] = r.exclude_shared_scans ? "shared_scan" : "same_scans";
+  json["self_match"] = SelfMatchName(r.self_match);
+  json["truth_is_map_log"] = r.truth_is_map_log;
+  json["first_scan"] = r.first_scan;
+  json["scans"] = r.log_scans;
   json["n_pos_requested"] = r.n_requested;
   json["n_pos"] = s.n_pos;
   json["n_acc"] = s.n_acc;
@@ -143,6 +199,10 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["n_ambiguous"] = s.n_ambiguous;
   json["precision"] = s.precision;
   json["recall"] = s.recall;
+  json["n_revisitable"] = s.n_revisitable;
+  json["recall_revisitable"] = s.recall_revisitable;
+  json["revisit_radius_m"] = r.evaluation.revisit_radius_m;
+  json["revisit_angle_deg"] = r.evaluation.revisit_angle_deg;
   json["scans_mean"] = s.scans_mean;
   json["scans_mean_all_queries"] = s.scans_mean_all_queries;
   json["seconds_per_query_mean"] = s.seconds_per_query_mean;
@@ -152,6 +212,7 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["p_gl"] = s.p_gl;
   json["p_cl"] = s.p_cl;
   json["curve"] = CurveJson(s.curve);
+  json["reliability"] = ReliabilityJson(s.reliability);
   nlohmann::json others;
   for (const RankBy key :
        {RankBy::kGamma, RankBy::kConfidence, RankBy::kConsensus, RankBy::kScore}) {

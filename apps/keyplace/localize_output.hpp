@@ -8,7 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/global_localization.hpp"
+#include "keyplace/eval/localization.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -24,18 +26,29 @@ struct LocalizeReport {
   std::string preset;
   bool baseline = false;
   bool exclude_shared_scans = false;
+  SelfMatchRule self_match = SelfMatchRule::kSameScans;  // the rule in force
+  bool truth_is_map_log = true;                          // TruthIsMapLog
+  std::size_t first_scan = 0;                            // --scans: the queries' part of the log
+  std::size_t file_scans = 0;
+  EvaluationConfig evaluation;  // revisit_radius_m, revisit_angle_deg
   PlaceRecognitionConfig place;
   LocalizationSummary summary;
   double preparation_seconds = 0.0;
 };
 
-/// Warns on stderr when the map was not built from corrected poses of the truth's log.
+/// Warns on stderr when the map was not built from corrected poses, and when the truth log has
+/// the map's log file name but other contents (`truth_is_map_log`: TruthIsMapLog), so that the
+/// queries count as another recording.
 void WarnAboutMapSource(const std::string& map_path, const GlobalMap& map,
-                        const std::string& truth_log_path);
+                        const std::string& truth_log_path, bool truth_is_map_log);
 
 void PrintLocalizeReport(const LocalizeReport& report);
-void WriteQueriesTsv(const std::string& path, const std::vector<LocalizationRecord>& records);
+/// start_scan and evaluated_scan as scans of the file: `first_scan` is the query log's --scans
+/// start (records number the scans of the cut log).
+void WriteQueriesTsv(const std::string& path, const std::vector<LocalizationRecord>& records,
+                     std::size_t first_scan);
 void WriteCurveTsv(const std::string& path, const std::vector<PrPoint>& curve);
+void WriteReliabilityTsv(const std::string& path, const std::vector<ReliabilityBin>& bins);
 /// The figures; the caller adds what it alone knows (map path, config, total time).
 nlohmann::json LocalizeJson(const LocalizeReport& report,
                             const std::vector<LocalizationRecord>& records);

@@ -28,6 +28,7 @@ struct MapOptions {
   std::string json_path;
   std::string png_path;
   std::string svg_path;
+  std::string scans;
   ConfigOptions config;
   bool overlap_only = false;
   bool skip_bad_lines = false;
@@ -44,12 +45,21 @@ const PaperMappingRow* PaperRow(const std::string& log_path, bool overlap_only) 
 void PrintMapReport(const MapOptions& options, const LogInputs& inputs, const LogMap& result) {
   const MappingStats& stats = result.stats;
   const std::size_t scans = inputs.log.scans.size();
+  // Submap scan indices are scans of the file (MapLog), like --scans.
+  const std::size_t end = inputs.first_scan + scans;
   const std::size_t covered =
-      result.map.submaps.empty() ? 0 : result.map.submaps.back().last_scan() + 1;
-  fmt::print("log                  {} ({} scans, {} poses)\n", options.input, scans,
-             ToString(inputs.pose_source));
-  fmt::print("submaps              {} ({} forced by the scan or grid limit), scans 0..{} of {}\n",
-             stats.submaps, stats.forced_submaps, covered, scans);
+      result.map.submaps.empty()
+          ? inputs.first_scan
+          : static_cast<std::size_t>(result.map.submaps.back().last_scan()) + 1;
+  if (inputs.first_scan == 0 && scans == inputs.file_scans) {
+    fmt::print("log                  {} ({} scans, {} poses)\n", options.input, scans,
+               ToString(inputs.pose_source));
+  } else {
+    fmt::print("log                  {} (scans {}:{} of {}, {} poses)\n", options.input,
+               inputs.first_scan, end, inputs.file_scans, ToString(inputs.pose_source));
+  }
+  fmt::print("submaps              {} ({} forced by the scan or grid limit), scans {}..{} of {}\n",
+             stats.submaps, stats.forced_submaps, inputs.first_scan, covered, end);
   fmt::print("scans per submap     {:.2f}\n", stats.scans_per_submap);
   fmt::print("keypoints per submap {:.2f}\n", stats.keypoints_per_submap);
   fmt::print("compression          {:.3f} ({} stable of {} keypoints: {:.1f} % less map data)\n",
@@ -79,6 +89,7 @@ void PrintMapReport(const MapOptions& options, const LogInputs& inputs, const Lo
 
 void DrawFigures(const MapOptions& options, const LogInputs& inputs, const LogMap& result) {
   MapFigureOptions figure;
+  figure.first_scan = inputs.first_scan;
   figure.title = fmt::format("{}: {} submaps, {} stable keypoints ({} poses)",
                              result.map.source_log, result.stats.submaps,
                              result.stats.stable_keypoints, ToString(inputs.pose_source));
@@ -95,6 +106,8 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   json["dataset"] = dataset ? *dataset : "";
   json["pose_source"] = ToString(inputs.pose_source);
   json["scans"] = inputs.log.scans.size();
+  json["first_scan"] = inputs.first_scan;
+  json["scans_in_log"] = inputs.file_scans;
   json["compression"] = stats.compression;
   json["scans_per_submap"] = stats.scans_per_submap;
   json["keypoints_per_submap"] = stats.keypoints_per_submap;
@@ -133,6 +146,7 @@ void RunMap(const MapOptions& options) {
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
+  ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
   PrintLogWarnings(inputs.log);
   Progress progress("mapping", inputs.log.scans.size());
@@ -175,6 +189,9 @@ void RegisterMapCommand(CLI::App& app) {
   command->add_flag("--overlap-only", options->overlap_only,
                     "Complete submaps on the overlap criterion alone (paper Section 3.1.3, as "
                     "for Table II): no distribution or keypoint-count criterion");
+  command->add_option("--scans", options->scans,
+                      "Map only the scans A:B of the log (e.g. 0:700, the first part of a "
+                      "time split); the map's scan indices stay those of the whole file");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   AddConfigOptions(command, options->config);
   command->callback([options] { RunMap(*options); });

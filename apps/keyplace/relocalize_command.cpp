@@ -3,7 +3,6 @@
 // until it declares a fix or gives up; every fix it reports is checked against the truth.
 
 #include <chrono>
-#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,7 +12,6 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
-#include "io/file_fingerprint.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/store/map_file.hpp"
@@ -28,7 +26,7 @@ struct RelocalizeOptions {
   std::string poses = "corrected";
   std::string truth_path;
   std::string index_path;
-  std::string scans = ":";
+  std::string scans;
   std::string self_match = "shared-scan";
   std::string json_path;
   std::string tsv_path;
@@ -44,6 +42,8 @@ RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config&
   options.starts = o.starts;
   options.give_up_m = config.evaluation.give_up_m;
   options.follow_m = config.evaluation.follow_m;
+  options.revisit_m = config.evaluation.revisit_radius_m;
+  options.revisit_deg = config.evaluation.revisit_angle_deg;
   // Scan indices of another recording say nothing about this one: no self-match rule there.
   options.exclude_shared_scans = o.self_match == "shared-scan" && query_log_is_map_log;
   return options;
@@ -60,14 +60,12 @@ void RunRelocalize(const RelocalizeOptions& options) {
   input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
-  // The log's end is not known yet: PrepareLogInputs cuts an open range at it.
-  const ScanRange range = ParseScanRange(options.scans, std::numeric_limits<std::size_t>::max());
-  input_options.first_scan = range.begin;
-  input_options.end_scan = range.end;
+  ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   PrintLogWarnings(inputs.log);
   const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
-                                            options.truth_path, options.index_path);
+                                            options.truth_path, options.index_path,
+                                            inputs.source_hash);
 
   RelocalizeReport report;
   report.map_path = options.map_path;
@@ -75,7 +73,7 @@ void RunRelocalize(const RelocalizeOptions& options) {
   report.first_scan = inputs.first_scan;
   report.end_scan = inputs.first_scan + inputs.log.scans.size();
   report.pose_source = inputs.pose_source;
-  report.query_log_is_map_log = map.source_hash == FileFingerprint(truth.truth_log);  // TEMP
+  report.query_log_is_map_log = TruthIsMapLog(map, truth);
   report.options = BenchmarkOptions(options, config, report.query_log_is_map_log);
   report.seconds_keypoints_per_scan =
       inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());

@@ -3,7 +3,6 @@
 // place sweep evaluates Algorithm 4 through the same library calls as keyplace localize.
 
 #include <cstddef>
-#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -49,11 +48,7 @@ LogInputs PrepareInputs(const SweepOptions& options, const Config& config, bool 
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
-  if (!options.scans.empty()) {
-    const ScanRange range = ParseScanRange(options.scans, std::numeric_limits<std::size_t>::max());
-    input_options.first_scan = range.begin;
-    input_options.end_scan = range.end;
-  }
+  ApplyScanRange(options.scans, input_options);
   LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   if (inputs.log.scans.size() < 2) {
     throw std::invalid_argument("--scans '" + options.scans + "': fewer than 2 scans");

@@ -29,7 +29,8 @@ PlaceSweepSetting PreparePlaceSweepSetting(const LogInputs& inputs, const Mappin
                                            int n_pos,
                                            PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
   const GlobalMap map = BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, mapping);
-  const GroundTruth truth = TruthFromOwnPoses(inputs.log);
+  // Map and queries number the scans of the cut log alike; the fingerprint is the one already read.
+  const GroundTruth truth = TruthFromOwnPoses(inputs.log, 0, inputs.source_hash);
   PlaceSweepSetting prepared;
   prepared.submaps = map.submaps.size();
   prepared.places = PlacesFromMap(map);

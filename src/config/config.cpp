@@ -86,6 +86,10 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
                 "relations with |t_b - t_a| below this are local, the others loop")
         .Int("truth_max_gap_scans", &C::truth_max_gap_scans, "",
              "slam loops are checked when their origins are this close to a corrected scan")
+        .Double("revisit_radius_m", &C::revisit_radius_m, "m",
+                "a localize query is revisitable with a map scan this close to its true pose")
+        .Double("revisit_angle_deg", &C::revisit_angle_deg, "deg",
+                "... and a heading this close (recall_revisitable)")
         .Double("give_up_m", &C::give_up_m, "m",
                 "relocalize: a start without a fix is given up after this odometry distance")
         .Double("follow_m", &C::follow_m, "m",
@@ -105,6 +109,12 @@ void Validate(const EvaluationConfig& config) {
   if (!(config.give_up_m > 0.0) || !(config.follow_m >= 0.0)) {
     throw std::invalid_argument(
         "EvaluationConfig.give_up_m must be positive and EvaluationConfig.follow_m >= 0");
+  }
+  if (!(config.revisit_radius_m >= 0.0)) {
+    throw std::invalid_argument("EvaluationConfig.revisit_radius_m must be >= 0");
+  }
+  if (!(config.revisit_angle_deg >= 0.0 && config.revisit_angle_deg <= 180.0)) {
+    throw std::invalid_argument("EvaluationConfig.revisit_angle_deg must be in [0, 180]");
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include "keyplace/localization/query_builder.hpp"
@@ -26,7 +27,7 @@ void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth, Local
   query.evaluated_scan = builder.scan_id(evaluated_position);
   for (std::size_t k = 0; k < builder.size(); ++k) {
     const auto scan = static_cast<std::size_t>(builder.scan_id(k));
-    if (truth.Has(scan)) query.truth_scans.push_back(truth.truth_index_of_scan[scan]);
+    if (truth.Has(scan)) query.truth_scans.push_back(truth.TruthScan(scan));
   }
   std::sort(query.truth_scans.begin(), query.truth_scans.end());
   query.truth = truth.Pose(static_cast<std::size_t>(query.evaluated_scan));
@@ -91,7 +92,7 @@ std::vector<LocalizationQuery> BuildScanQueries(const LogInputs& inputs, const G
       query.query.positions.push_back(inputs.log.scans[scan].T_robot_laser * keypoint.position_m);
       query.query.descriptors.push_back(keypoint.descriptor);
     }
-    query.truth_scans = {truth.truth_index_of_scan[scan]};
+    query.truth_scans = {truth.TruthScan(scan)};
     query.truth = truth.Pose(scan);
     queries.push_back(std::move(query));
   }
@@ -160,6 +161,73 @@ std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQu
   return records;
 }
 
+bool IsRevisitable(const LocalizationQuery& query, const std::vector<Submap>& map_scans,
+                   SelfMatchRule rule, const EvaluationConfig& config) {
+  const double max_angle_rad = config.revisit_angle_deg * M_PI / 180.0;
+  for (const Submap& submap : map_scans) {
+    const bool near = std::any_of(submap.poses.begin(), submap.poses.end(), [&](const Pose2& p) {
+      return std::hypot(p.x - query.truth.x, p.y - query.truth.y) <= config.revisit_radius_m &&
+             std::abs(WrapAngle(p.theta - query.truth.theta)) <= max_angle_rad;
+    });
+    // The rule is checked only for nearby places: it sorts both scan lists.
+    if (near && !IsSelfMatch(rule, query.truth_scans, submap.scan_indices)) return true;
+  }
+  return false;
+}
+
+void MarkRevisitable(const std::vector<LocalizationQuery>& queries,
+                     const std::vector<Submap>& map_scans, SelfMatchRule rule,
+                     const EvaluationConfig& config, std::vector<LocalizationRecord>& records) {
+  if (records.size() != queries.size()) {
+    throw std::invalid_argument("MarkRevisitable: " + std::to_string(records.size()) +
+                                " records for " + std::to_string(queries.size()) + " queries");
+  }
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    records[i].revisitable = IsRevisitable(queries[i], map_scans, rule, config);
+  }
+}
+
+std::vector<Submap> ScanPlacesAsSubmaps(const std::vector<Place>& places) {
+  std::vector<Submap> submaps;
+  submaps.reserve(places.size());
+  for (const Place& place : places) {
+    Submap submap;
+    submap.id = place.id;
+    submap.scan_indices = place.scan_indices;
+    submap.poses = {place.T_world_place};
+    submaps.push_back(std::move(submap));
+  }
+  return submaps;
+}
+
+std::vector<ReliabilityBin> ReliabilityDiagram(const std::vector<LocalizationRecord>& records) {
+  const auto bins = static_cast<std::size_t>(std::lround(1.0 / kReliabilityBinWidth));
+  std::vector<ReliabilityBin> diagram(bins);
+  std::vector<std::size_t> correct(bins, 0);
+  for (std::size_t b = 0; b < bins; ++b) {
+    diagram[b].bin_low = static_cast<double>(b) / static_cast<double>(bins);
+    diagram[b].bin_high = static_cast<double>(b + 1) / static_cast<double>(bins);
+  }
+  for (const LocalizationRecord& r : records) {
+    if (!r.match.found) continue;
+    const double confidence = std::clamp(r.match.confidence, 0.0, 1.0);
+    // Times the bin count, not divided by the width: 0.3 / 0.1 falls just below 3. Confidence 1
+    // belongs to the last bin.
+    const std::size_t b =
+        std::min(bins - 1, static_cast<std::size_t>(confidence * static_cast<double>(bins)));
+    ++diagram[b].count;
+    diagram[b].confidence_mean += r.match.confidence;
+    if (r.correct) ++correct[b];
+  }
+  for (std::size_t b = 0; b < bins; ++b) {
+    if (diagram[b].count == 0) continue;
+    const auto count = static_cast<double>(diagram[b].count);
+    diagram[b].confidence_mean /= count;
+    diagram[b].precision = static_cast<double>(correct[b]) / count;
+  }
+  return diagram;
+}
+
 LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, RankBy rank_by) {
   LocalizationSummary s;
   s.n_pos = records.size();
@@ -183,11 +251,18 @@ LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, Ra
       ++s.n_cor;
       scans_correct += r.scans;
     }
+    if (r.revisitable) {
+      ++s.n_revisitable;
+      if (r.correct) ++s.n_cor_revisitable;
+    }
     answers.push_back({r.match.verified, r.verified_correct, RankScore(rank_by, r.match)});
   }
   const auto n = static_cast<double>(s.n_pos);
   s.precision = s.n_acc > 0 ? static_cast<double>(s.n_cor) / static_cast<double>(s.n_acc) : 0.0;
   s.recall = s.n_pos > 0 ? static_cast<double>(s.n_cor) / n : 0.0;
+  s.recall_revisitable = s.n_revisitable > 0 ? static_cast<double>(s.n_cor_revisitable) /
+                                                   static_cast<double>(s.n_revisitable)
+                                             : 0.0;
   s.scans_mean = s.n_cor > 0 ? scans_correct / static_cast<double>(s.n_cor) : 0.0;
   s.scans_mean_all_queries = s.n_pos > 0 ? scans_all / n : 0.0;
   s.seconds_per_query_mean = s.n_pos > 0 ? seconds / n : 0.0;
@@ -195,6 +270,7 @@ LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, Ra
   s.curve = PrecisionRecallCurve(answers, s.n_pos);
   s.p_gl = PrecisionAtMaxRecall(s.curve);
   s.p_cl = RecallAtPrecision(s.curve, 0.95);
+  s.reliability = ReliabilityDiagram(records);
   return s;
 }
 
@@ -208,13 +284,13 @@ std::vector<Place> ScanPlaces(const LogInputs& map_log) {
                                   ": single-scan places need corrected poses");
     }
     Place place;
-    place.id = static_cast<int>(k);
+    place.id = static_cast<int>(map_log.first_scan + k);
     place.T_world_place = *scan.corrected_pose;
     for (const Keypoint& keypoint : map_log.keypoints[k]) {
       place.positions.push_back(scan.T_robot_laser * keypoint.position_m);
       place.descriptors.push_back(keypoint.descriptor);
     }
-    place.scan_indices = {static_cast<int>(k)};
+    place.scan_indices = {static_cast<int>(map_log.first_scan + k)};
     places.push_back(std::move(place));
   }
   return places;

@@ -1,8 +1,11 @@
 #include "keyplace/eval/ground_truth.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+
+#include "io/file_fingerprint.hpp"
 
 namespace keyplace {
 
@@ -12,7 +15,8 @@ std::size_t GroundTruth::Count() const {
                                                 [](int index) { return index >= 0; }));
 }
 
-GroundTruth TruthFromOwnPoses(const CarmenLog& log) {
+GroundTruth TruthFromOwnPoses(const CarmenLog& log, std::size_t first_scan,
+                              const std::string& log_hash) {
   if (!log.corrected) {
     throw std::invalid_argument(log.path +
                                 " has no corrected poses: give --truth CORRECTED_LOG and --index "
@@ -20,6 +24,10 @@ GroundTruth TruthFromOwnPoses(const CarmenLog& log) {
   }
   GroundTruth truth;
   truth.truth_log = log.path;
+  // A log built in memory (no path) has no file to fingerprint.
+  truth.truth_log_hash =
+      !log_hash.empty() || log.path.empty() ? log_hash : FileFingerprint(log.path);
+  truth.truth_first_scan = first_scan;
   for (std::size_t k = 0; k < log.scans.size(); ++k) {
     const LogScan& scan = log.scans[k];
     if (!scan.corrected_pose) {
@@ -60,12 +68,18 @@ GroundTruth TruthFromIndex(const CarmenLog& log, std::size_t first_scan, std::si
 }
 
 GroundTruth LoadGroundTruth(const CarmenLog& log, std::size_t first_scan, std::size_t file_scans,
-                            const std::string& truth_path, const std::string& index_path) {
+                            const std::string& truth_path, const std::string& index_path,
+                            const std::string& log_hash) {
   if (truth_path.empty() != index_path.empty()) {
     throw std::invalid_argument("--truth and --index must be given together");
   }
-  if (truth_path.empty()) return TruthFromOwnPoses(log);
+  if (truth_path.empty()) return TruthFromOwnPoses(log, first_scan, log_hash);
   return TruthFromIndex(log, first_scan, file_scans, truth_path, index_path);
+}
+
+bool TruthIsMapLog(const GlobalMap& map, const GroundTruth& truth) {
+  if (!map.source_hash.empty()) return map.source_hash == truth.truth_log_hash;
+  return map.source_log == std::filesystem::path(truth.truth_log).filename().string();
 }
 
 }  // namespace keyplace

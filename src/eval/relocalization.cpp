@@ -96,7 +96,7 @@ class StartRun {
       if (!record_.fixed && travelled_m > options_.give_up_m) break;
       if (record_.fixed && travelled_m > fixed_at_m + options_.follow_m) break;
       if (!record_.fixed && !record_.revisit && truth_.Has(k)) {
-        record_.revisit = revisits_.IsRevisit(truth_.Pose(k), truth_.truth_index_of_scan[k]);
+        record_.revisit = revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k));
       }
       const auto begin = std::chrono::steady_clock::now();
       const RelocalizationUpdate update =
@@ -119,7 +119,7 @@ class StartRun {
   }
 
  private:
-  int TruthIndex(std::size_t k) const { return truth_.Has(k) ? truth_.truth_index_of_scan[k] : -1; }
+  int TruthIndex(std::size_t k) const { return truth_.Has(k) ? truth_.TruthScan(k) : -1; }
 
   void Record(const RelocalizationUpdate& update, std::size_t k, double travelled_m) {
     if (update.lost) RecordLost(k);

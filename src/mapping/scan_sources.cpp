@@ -132,6 +132,16 @@ LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
   LogMap result;
   result.map = BuildGlobalMap({inputs.log.scans, inputs.poses, inputs.keypoints}, config,
                               &result.timings, progress);
+  // The mapper numbers the scans of the cut log; a map names scans of the whole file, so that a
+  // map of scans A:B and queries of scans C:D of one log apply the self-match rule to the same
+  // numbers (the time-split protocol).
+  const int offset = static_cast<int>(inputs.first_scan);
+  if (offset != 0) {
+    for (Submap& submap : result.map.submaps) {
+      for (int& index : submap.scan_indices) index += offset;
+      for (StableKeypoint& keypoint : submap.keypoints) keypoint.scan_index += offset;
+    }
+  }
   result.map.source_log = inputs.source_log;
   result.map.source_hash = inputs.source_hash;
   result.map.pose_source = ToString(inputs.pose_source);

@@ -1,6 +1,6 @@
 #pragma once
-// Settings of the evaluations (not of the method): how relations are split and how far ground
-// truth is carried to scans without a corrected pose.
+// Settings of the evaluations (not of the method): how relations are split, how far ground
+// truth is carried to scans without a corrected pose, and which queries the map can answer.
 
 namespace keyplace {
 
@@ -11,6 +11,11 @@ struct EvaluationConfig {
   // this many scans (processing order) from a scan with a corrected pose; FR101 has one corrected
   // scan per 16 raw ones.
   int truth_max_gap_scans = 50;
+  // A query of `keyplace localize` is revisitable when its true pose has a map scan (of a place
+  // the self-match rule leaves in) within this distance and this heading difference: the map
+  // has seen the place, so a query without a correct answer there is a miss.
+  double revisit_radius_m = 1.5;
+  double revisit_angle_deg = 45.0;
   // keyplace relocalize: a start without a fix is given up after this odometry distance, and
   // after its first fix the fixes are checked over this further distance.
   double give_up_m = 50.0;

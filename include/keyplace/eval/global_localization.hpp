@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/localization.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
@@ -27,8 +28,10 @@ struct LocalizationQuery {
   int evaluated_scan = 0;  // its latest scan with a truth pose: the pose estimated
   int scans = 0;           // scans in the query (1 for single-scan queries)
   PlaceQuery query;
-  std::vector<int> truth_scans;  // sorted truth-log indices of its scans (self-match rule)
-  Pose2 truth;                   // true pose of evaluated_scan
+  // Sorted truth-log file indices of its scans (GroundTruth::TruthScan): the self-match rule
+  // compares them with the map's file scan indices.
+  std::vector<int> truth_scans;
+  Pose2 truth;  // true pose of evaluated_scan
   double build_seconds = 0.0;
 };
 
@@ -58,6 +61,8 @@ struct LocalizationRecord {
   Pose2 truth;
   bool correct = false;           // accepted and within 0.5 m / 10 deg
   bool verified_correct = false;  // best verified candidate within 0.5 m / 10 deg
+  // A map scan lies near the true pose (IsRevisitable) in a place the self-match rule left in.
+  bool revisitable = false;
   double build_seconds = 0.0;
 };
 
@@ -67,6 +72,22 @@ RankBy ParseRankBy(const std::string& name);  // confidence | gamma | consensus 
 std::string ToString(RankBy rank_by);
 double RankScore(RankBy rank_by, const PlaceMatch& match);
 
+/// Accepted answers whose confidence falls in [bin_low, bin_high) (the last bin includes 1): a
+/// calibrated confidence has precision close to confidence_mean in every bin.
+struct ReliabilityBin {
+  double bin_low = 0.0;
+  double bin_high = 0.0;
+  std::size_t count = 0;         // accepted answers in the bin
+  double confidence_mean = 0.0;  // 0 when count is 0
+  double precision = 0.0;        // correct / count; 0 when count is 0
+};
+
+/// Width of the reliability bins: 10 bins over [0, 1].
+inline constexpr double kReliabilityBinWidth = 0.1;
+
+/// The reliability diagram of the accepted answers of `records` by PlaceMatch::confidence.
+std::vector<ReliabilityBin> ReliabilityDiagram(const std::vector<LocalizationRecord>& records);
+
 /// The figures of a set of records.
 struct LocalizationSummary {
   std::size_t n_pos = 0;  // queries evaluated
@@ -75,8 +96,14 @@ struct LocalizationSummary {
   std::size_t n_verified = 0;
   std::size_t n_ambiguous = 0;
   std::size_t n_ambiguous_wrong = 0;
-  double precision = 0.0;   // n_cor / n_acc (0 when nothing was accepted)
-  double recall = 0.0;      // n_cor / n_pos
+  double precision = 0.0;  // n_cor / n_acc (0 when nothing was accepted)
+  double recall = 0.0;     // n_cor / n_pos
+  // Queries whose place the map has seen (LocalizationRecord::revisitable), and the correct
+  // answers among them / n_revisitable (0 when there is none): misses of places seen once in the
+  // query log do not count.
+  std::size_t n_revisitable = 0;
+  std::size_t n_cor_revisitable = 0;
+  double recall_revisitable = 0.0;
   double scans_mean = 0.0;  // scans of the correctly answered queries
   double scans_mean_all_queries = 0.0;
   double seconds_per_query_mean = 0.0;  // recognition
@@ -85,17 +112,37 @@ struct LocalizationSummary {
   std::vector<PrPoint> curve;  // ranked by rank_by
   double p_gl = 0.0;
   double p_cl = 0.0;
+  std::vector<ReliabilityBin> reliability;  // ReliabilityDiagram
 };
 LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, RankBy rank_by);
 
-/// Recognises every query with `recognizer`, skipping the places `rule` calls self-matches.
+/// Recognises every query with `recognizer`, skipping the places `rule` calls self-matches. Each
+/// record's `revisitable` is false; MarkRevisitable sets it.
 std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQuery>& queries,
                                                 const PlaceRecognizer& recognizer,
                                                 SelfMatchRule rule,
                                                 const QueryProgress& progress = {});
 
+/// Whether the true pose of `query` has a scan of `map_scans` within
+/// config.revisit_radius_m and config.revisit_angle_deg whose place `rule` does not exclude for
+/// this query (the exclusion EvaluateQueries applies). `map_scans` are places with the world
+/// poses of their scans: submaps (Submap::poses, the map's frame), or single scans.
+bool IsRevisitable(const LocalizationQuery& query, const std::vector<Submap>& map_scans,
+                   SelfMatchRule rule, const EvaluationConfig& config);
+
+/// Sets records[i].revisitable = IsRevisitable(queries[i], ...); records[i] must answer
+/// queries[i] (EvaluateQueries keeps the order). Throws std::invalid_argument on a size mismatch.
+void MarkRevisitable(const std::vector<LocalizationQuery>& queries,
+                     const std::vector<Submap>& map_scans, SelfMatchRule rule,
+                     const EvaluationConfig& config, std::vector<LocalizationRecord>& records);
+
+/// The single-scan places of ScanPlaces as one-scan submaps (their scan index and pose), for
+/// IsRevisitable.
+std::vector<Submap> ScanPlacesAsSubmaps(const std::vector<Place>& places);
+
 /// The places of the TIP-FLIRT baseline: every scan of a log with corrected poses, all its FLIRT
-/// keypoints in the robot frame.
+/// keypoints in the robot frame; scan indices are those of the file (offset by
+/// map_log.first_scan), like a map's.
 std::vector<Place> ScanPlaces(const LogInputs& map_log);
 
 }  // namespace keyplace

@@ -88,7 +88,7 @@ using StartProgress = std::function<void(std::size_t, std::size_t)>;
 
 /// Runs the benchmark on `inputs` (poses = the odometry fed to the localizer, keypoints
 /// extracted) against `map`. With exclude_shared_scans, the localizer's scan ids are the truth
-/// indices of the scans (GroundTruth::truth_index_of_scan) and map submaps sharing one with the
+/// file indices of the scans (GroundTruth::TruthScan) and map submaps sharing one with the
 /// current query are skipped.
 std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs& inputs,
                                            const GroundTruth& truth, const LocalizerConfig& config,

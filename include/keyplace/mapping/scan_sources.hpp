@@ -83,7 +83,7 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
 
 /// A log's global map (Algorithm 2) with its provenance and the mapping criteria of Section 5.1.
 struct LogMap {
-  GlobalMap map;  // source_log, source_hash, pose_source set from the inputs
+  GlobalMap map;  // source_log, source_hash, pose_source set from the inputs; file scan indices
   MappingStats stats;
   GlobalMappingTimings timings;
   double seconds_per_submap_mapping = 0.0;  // mean time to build a submap (keypoints given)
@@ -91,7 +91,9 @@ struct LogMap {
   double seconds_per_submap = 0.0;
 };
 
-/// Builds the map of `inputs` with `config`; `progress` (may be empty) gets the next scan index.
+/// Builds the map of `inputs` with `config`; `progress` (may be empty) gets the next scan index
+/// (of the cut log). The map's scan indices (Submap::scan_indices, StableKeypoint::scan_index)
+/// are scans of the whole file: offset by inputs.first_scan.
 LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
               const std::function<void(std::size_t)>& progress = {});
 
