@@ -30,6 +30,7 @@ struct RelocalizeOptions {
   std::string self_match = "shared-scan";
   std::string json_path;
   std::string tsv_path;
+  std::string fixes_path;
   std::string figure_path;
   ConfigOptions config;
   int starts = 50;
@@ -44,6 +45,7 @@ RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config&
   options.follow_m = config.evaluation.follow_m;
   options.revisit_m = config.evaluation.revisit_radius_m;
   options.revisit_deg = config.evaluation.revisit_angle_deg;
+  options.truth_max_gap_scans = config.evaluation.truth_max_gap_scans;
   // Scan indices of another recording say nothing about this one: no self-match rule there.
   options.exclude_shared_scans = o.self_match == "shared-scan" && query_log_is_map_log;
   return options;
@@ -63,9 +65,9 @@ void RunRelocalize(const RelocalizeOptions& options) {
   ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   PrintLogWarnings(inputs.log);
-  const GroundTruth truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
-                                            options.truth_path, options.index_path,
-                                            inputs.source_hash);
+  const GroundTruth truth =
+      LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans, options.truth_path,
+                      options.index_path, inputs.source_hash);
 
   RelocalizeReport report;
   report.map_path = options.map_path;
@@ -86,6 +88,7 @@ void RunRelocalize(const RelocalizeOptions& options) {
   report.seconds_total = SecondsSince(start);
   PrintRelocalizeReport(report, map);
   if (!options.tsv_path.empty()) WriteStartsTsv(options.tsv_path, report.records);
+  if (!options.fixes_path.empty()) WriteFixesTsv(options.fixes_path, report.records);
   if (!options.figure_path.empty()) {
     DrawRelocalization(options.figure_path, report, map, inputs, truth);
   }
@@ -105,7 +108,8 @@ void RegisterRelocalizeCommand(CLI::App& app) {
       "The kidnapped-robot benchmark: from --starts starts spread over the query log the "
       "localizer, knowing nothing, is fed scans and odometry until two answers agree on a fix "
       "(or it gives up after evaluation.give_up_m of travel); it then runs evaluation.follow_m "
-      "further and every fix it reports is checked against the truth (0.5 m, 10 deg).");
+      "further and every fix it reports is checked against the truth (0.5 m, 10 deg). Uses the "
+      "strict preset unless --preset says otherwise.");
   command->add_option("--map", options->map_path, "Map file (.kpm)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -138,9 +142,14 @@ void RegisterRelocalizeCommand(CLI::App& app) {
                    "than the map's is never excluded")
       ->check(CLI::IsMember({"shared-scan", "none"}))
       ->capture_default_str();
+  // A robot acts on a fix: the strict preset's reference-coverage check keeps wrong fixes out
+  // when the map was recorded on another day (docs/RESULTS.md, kidnapped robot).
+  options->config.preset = "strict";
   AddConfigOptions(command, options->config);
   command->add_option("--json", options->json_path, "Write the summary as JSON to FILE");
   command->add_option("--tsv", options->tsv_path, "Write one TSV row per start to FILE");
+  command->add_option("--fixes", options->fixes_path,
+                      "Write one TSV row per fix reported (pose, truth, error) to FILE");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);

@@ -1,5 +1,6 @@
 #include "relocalize_output.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include <fmt/core.h>
@@ -28,33 +29,56 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              s.fixed_fraction, s.fixed_with_revisit, s.starts_with_revisit, s.fixed);
   fmt::print("to first fix median {:.2f} m, 90th percentile {:.2f} m, median {:.0f} scans\n",
              s.distance_to_fix_median_m, s.distance_to_fix_p90_m, s.scans_to_fix_median);
-  fmt::print("fixes        {} checked over {} m after each first fix, {} wrong (rate {:.4f}); "
-             "{} wrong first fixes\n",
-             s.fixes, o.follow_m, s.wrong_fixes, s.wrong_fix_rate, s.wrong_first_fixes);
+  fmt::print(
+      "fixes        {} checked over {} m after each first fix, {} wrong (rate {:.4f}); "
+      "{} wrong first fixes\n",
+      s.fixes, o.follow_m, s.wrong_fixes, s.wrong_fix_rate, s.wrong_first_fixes);
   fmt::print("wrong fixes  {} (highest confidence {:.3f}, confident = {})\n",
              s.wrong_fix_confident ? "one was reported as confident" : "none was confident",
              s.wrong_fix_confidence_max, o.confident);
   fmt::print("lost         {} signals: {} on a correct track, {} on a wrong one\n", s.lost_signals,
              s.lost_on_correct_track, s.lost_on_wrong_track);
-  fmt::print("update       mean {:.2f} ms, max {:.1f} ms per AddScan with keypoints given; FLIRT "
-             "{:.2f} ms per scan\n",
-             1e3 * s.update_seconds_mean, 1e3 * s.update_seconds_max,
-             1e3 * r.seconds_keypoints_per_scan);
+  fmt::print(
+      "update       mean {:.2f} ms, max {:.1f} ms per AddScan with keypoints given; FLIRT "
+      "{:.2f} ms per scan\n",
+      1e3 * s.update_seconds_mean, 1e3 * s.update_seconds_max, 1e3 * r.seconds_keypoints_per_scan);
   fmt::print("time         {:.1f} s\n", r.seconds_total);
 }
 
 void WriteStartsTsv(const std::string& path, const std::vector<StartRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "start_scan\tend_scan\trevisit\tfixed\tscans_to_fix\tdistance_to_fix_m\t"
+    out << "start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_"
+           "fix_m\t"
            "first_fix_correct\tanswers\tanswers_accepted\tfixes\twrong_fixes\tlost\t"
            "lost_on_correct_track\tlost_on_wrong_track\tupdate_seconds_mean\t"
            "update_seconds_max\n";
     for (const StartRecord& r : records) {
-      fmt::print(out, "{}\t{}\t{:d}\t{:d}\t{}\t{:.3f}\t{:d}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6f}\t{:.6f}\n",
-                 r.start_scan, r.end_scan, r.revisit, r.fixed, r.scans_to_fix,
-                 r.distance_to_fix_m, r.first_fix_correct, r.answers, r.answers_accepted,
-                 r.fixes.size(), r.wrong_fixes, r.lost, r.lost_on_correct_track,
+      fmt::print(out,
+                 "{}\t{}\t{:d}\t{:.3f}\t{:d}\t{}\t{:.3f}\t{:d}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6f}"
+                 "\t{:.6f}\n",
+                 r.start_scan, r.end_scan, r.revisit, r.distance_to_revisit_m, r.fixed,
+                 r.scans_to_fix, r.distance_to_fix_m, r.first_fix_correct, r.answers,
+                 r.answers_accepted, r.fixes.size(), r.wrong_fixes, r.lost, r.lost_on_correct_track,
                  r.lost_on_wrong_track, r.update_seconds_mean, r.update_seconds_max);
+    }
+  });
+}
+
+void WriteFixesTsv(const std::string& path, const std::vector<StartRecord>& records) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "start_scan\tscan\tchecked_scan\tfirst\tcorrect\tconfidence\test_x\test_y\t"
+           "est_theta\ttrue_x\ttrue_y\ttrue_theta\terror_m\terror_deg\n";
+    for (const StartRecord& r : records) {
+      for (const FixEvent& f : r.fixes) {
+        const Pose2 error = Between(f.truth, f.T_world_robot);
+        fmt::print(out,
+                   "{}\t{}\t{}\t{:d}\t{:d}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}"
+                   "\t{:.3f}\t{:.2f}\n",
+                   r.start_scan, f.scan, f.checked_scan, f.first, f.correct, f.confidence,
+                   f.T_world_robot.x, f.T_world_robot.y, f.T_world_robot.theta, f.truth.x,
+                   f.truth.y, f.truth.theta, TranslationNorm(error),
+                   std::abs(error.theta) * 180.0 / M_PI);
+      }
     }
   });
 }
@@ -85,6 +109,8 @@ nlohmann::json RelocalizeJson(const RelocalizeReport& r) {
   json["distance_to_fix_median_m"] = s.distance_to_fix_median_m;
   json["distance_to_fix_p90_m"] = s.distance_to_fix_p90_m;
   json["scans_to_fix_median"] = s.scans_to_fix_median;
+  json["distance_after_revisit_median_m"] = s.distance_after_revisit_median_m;
+  json["distance_after_revisit_p90_m"] = s.distance_after_revisit_p90_m;
   json["update_seconds_mean"] = s.update_seconds_mean;
   json["update_seconds_max"] = s.update_seconds_max;
   json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan;

@@ -31,6 +31,7 @@ struct RelocalizeReport {
 
 void PrintRelocalizeReport(const RelocalizeReport& report, const GlobalMap& map);
 void WriteStartsTsv(const std::string& path, const std::vector<StartRecord>& records);
+void WriteFixesTsv(const std::string& path, const std::vector<StartRecord>& records);
 nlohmann::json RelocalizeJson(const RelocalizeReport& report);
 /// The map's scans, each start's true path to its first fix and its fixes (tools/).
 void DrawRelocalization(const std::string& path, const RelocalizeReport& report,

@@ -62,10 +62,13 @@ class RevisitChecker {
   int neighbourhood_ = 0;
 };
 
-// The truth at scan k or the next scan with one (a raw log has scans without a corrected twin).
-std::optional<std::size_t> ScanWithTruth(const GroundTruth& truth, std::size_t k, std::size_t end) {
-  for (std::size_t j = k; j < end && j < k + 10; ++j) {
-    if (truth.Has(j)) return j;
+// The scan nearest to k (either side, within max_gap scans of [begin, end)) that has a truth pose:
+// a raw log has scans without a corrected twin (FR101: one in 16). Odometry carries a fix there.
+std::optional<std::size_t> NearestScanWithTruth(const GroundTruth& truth, std::size_t k,
+                                                std::size_t begin, std::size_t end, int max_gap) {
+  for (std::size_t gap = 0; gap <= static_cast<std::size_t>(std::max(max_gap, 0)); ++gap) {
+    if (k + gap < end && truth.Has(k + gap)) return k + gap;
+    if (gap <= k && k - gap >= begin && truth.Has(k - gap)) return k - gap;
   }
   return std::nullopt;
 }
@@ -84,6 +87,7 @@ class StartRun {
     relocalizer_.Reset();
     record_ = StartRecord{};
     record_.start_scan = start_scan;
+    FindRevisit();
     const std::size_t scans = inputs_.log.scans.size();
     double travelled_m = 0.0;
     double fixed_at_m = 0.0;
@@ -95,9 +99,6 @@ class StartRun {
       }
       if (!record_.fixed && travelled_m > options_.give_up_m) break;
       if (record_.fixed && travelled_m > fixed_at_m + options_.follow_m) break;
-      if (!record_.fixed && !record_.revisit && truth_.Has(k)) {
-        record_.revisit = revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k));
-      }
       const auto begin = std::chrono::steady_clock::now();
       const RelocalizationUpdate update =
           relocalizer_.AddScan(inputs_.log.scans[k], inputs_.poses[k], inputs_.keypoints[k],
@@ -119,6 +120,30 @@ class StartRun {
   }
 
  private:
+  // The first scan before the give-up distance whose true pose the map has seen: whether the
+  // start can be fixed at all, whatever the localizer does.
+  void FindRevisit() {
+    double travelled_m = 0.0;
+    for (auto k = static_cast<std::size_t>(record_.start_scan); k < inputs_.log.scans.size(); ++k) {
+      if (k > static_cast<std::size_t>(record_.start_scan)) {
+        travelled_m += TranslationNorm(Between(inputs_.poses[k - 1], inputs_.poses[k]));
+      }
+      if (travelled_m > options_.give_up_m) return;
+      if (truth_.Has(k) && revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k))) {
+        record_.revisit = true;
+        record_.distance_to_revisit_m = travelled_m;
+        return;
+      }
+    }
+  }
+
+  // The scan a fix at scan k is checked at: scans fed so far, and a few ahead (odometry carries
+  // the fix there as well).
+  std::optional<std::size_t> CheckedScan(std::size_t k) const {
+    return NearestScanWithTruth(truth_, k, static_cast<std::size_t>(record_.start_scan),
+                                inputs_.log.scans.size(), options_.truth_max_gap_scans);
+  }
+
   int TruthIndex(std::size_t k) const { return truth_.Has(k) ? truth_.TruthScan(k) : -1; }
 
   void Record(const RelocalizationUpdate& update, std::size_t k, double travelled_m) {
@@ -133,7 +158,7 @@ class StartRun {
       record_.scans_to_fix = static_cast<int>(k) - record_.start_scan + 1;
       record_.distance_to_fix_m = travelled_m;
     }
-    const std::optional<std::size_t> checked = ScanWithTruth(truth_, k, inputs_.log.scans.size());
+    const std::optional<std::size_t> checked = CheckedScan(k);
     if (!checked) return;
     FixEvent fix;
     fix.scan = static_cast<int>(k);
@@ -141,15 +166,19 @@ class StartRun {
     fix.truth = truth_.Pose(*checked);
     fix.confidence = update.confidence;
     fix.correct = Within(fix.T_world_robot, fix.truth, options_.correct_m, options_.correct_deg);
+    fix.checked_scan = static_cast<int>(*checked);
     fix.first = first;
-    if (first) record_.first_fix_correct = fix.correct;
+    if (first) {
+      record_.first_fix_checked = true;
+      record_.first_fix_correct = fix.correct;
+    }
     if (!fix.correct) ++record_.wrong_fixes;
     record_.fixes.push_back(fix);
   }
 
   void RecordLost(std::size_t k) {
     ++record_.lost;
-    const std::optional<std::size_t> checked = ScanWithTruth(truth_, k, inputs_.log.scans.size());
+    const std::optional<std::size_t> checked = CheckedScan(k);
     if (!checked || !previous_T_world_odom_) return;
     const Pose2 track = *previous_T_world_odom_ * inputs_.poses[*checked];
     if (Within(track, truth_.Pose(*checked), options_.correct_m, options_.correct_deg)) {
@@ -206,6 +235,7 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   RelocalizationSummary s;
   s.starts = records.size();
   std::vector<double> distances;
+  std::vector<double> after_revisit;
   std::vector<double> scans_to_fix;
   double seconds_sum = 0.0;
   std::size_t updates = 0;
@@ -215,8 +245,10 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
       ++s.fixed;
       s.fixed_with_revisit += r.revisit ? 1 : 0;
       distances.push_back(r.distance_to_fix_m);
+      if (r.revisit)
+        after_revisit.push_back(std::max(0.0, r.distance_to_fix_m - r.distance_to_revisit_m));
       scans_to_fix.push_back(r.scans_to_fix);
-      if (!r.first_fix_correct) ++s.wrong_first_fixes;
+      if (r.first_fix_checked && !r.first_fix_correct) ++s.wrong_first_fixes;
     }
     for (const FixEvent& fix : r.fixes) {
       ++s.fixes;
@@ -240,6 +272,8 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   s.distance_to_fix_median_m = Quantile(distances, 0.5);
   s.distance_to_fix_p90_m = Quantile(distances, 0.9);
   s.scans_to_fix_median = Quantile(scans_to_fix, 0.5);
+  s.distance_after_revisit_median_m = Quantile(after_revisit, 0.5);
+  s.distance_after_revisit_p90_m = Quantile(after_revisit, 0.9);
   if (updates > 0) s.update_seconds_mean = seconds_sum / static_cast<double>(updates);
   return s;
 }

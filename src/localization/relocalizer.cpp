@@ -58,6 +58,7 @@ void FixFilter::Reset() {
   hypotheses_.clear();
   challengers_.clear();
   fix_confidence_ = 0.0;
+  fix_variance_m2_ = 0.0;
   confirmed_at_m_ = 0.0;
 }
 
@@ -106,11 +107,7 @@ void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
                       RelocalizationUpdate& update) {
   const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_};
   if (!Agreeing({fix}, hypothesis, T_odom_robot).empty()) {
-    // The newest answer carries the least odometry drift.
-    T_world_odom_ = hypothesis.T_world_odom;
-    fix_confidence_ = CombinedConfidence({fix_confidence_, hypothesis.confidence});
-    confirmed_at_m_ = odometry_m_;
-    challengers_.clear();
+    Confirm(hypothesis, T_odom_robot);
     update.confirmed = true;
     return;
   }
@@ -121,11 +118,34 @@ void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
     DeclareLost(update);
     DeclareFix(agreeing, hypothesis, update);
   } else if (hypothesis.confidence >= policy_.contradiction_confidence) {
+    // Either may be right: one more answer agreeing with the old fix restores it.
     DeclareLost(update);
-    hypotheses_.push_back(hypothesis);
+    hypotheses_ = {fix, hypothesis};
   } else {
     challengers_.push_back(hypothesis);
   }
+}
+
+// The fix and the answer are two estimates of the robot's pose now: the fix carries the odometry
+// drift since its last confirmation, the answer its own error (agree_m / 2, one sigma). Their
+// weighted mean is the new fix; its variance never falls below that of four answers, so odometry
+// that drifts more than agree_per_m allows is still pulled back by the answers.
+void FixFilter::Confirm(const Hypothesis& answer, const Pose2& T_odom_robot) {
+  const double answer_variance = 0.25 * policy_.agree_m * policy_.agree_m;
+  const double drift_m = policy_.agree_per_m * (odometry_m_ - confirmed_at_m_);
+  const double fix_variance = fix_variance_m2_ + drift_m * drift_m;
+  const double weight = fix_variance / (fix_variance + answer_variance);
+  const Pose2 fix_now = T_world_odom_ * T_odom_robot;
+  const Pose2 answer_now = answer.T_world_odom * T_odom_robot;
+  const Pose2 fused(fix_now.x + weight * (answer_now.x - fix_now.x),
+                    fix_now.y + weight * (answer_now.y - fix_now.y),
+                    fix_now.theta + weight * WrapAngle(answer_now.theta - fix_now.theta));
+  T_world_odom_ = fused * T_odom_robot.inverse();
+  fix_variance_m2_ = std::max(fix_variance * answer_variance / (fix_variance + answer_variance),
+                              answer_variance / 4.0);
+  fix_confidence_ = CombinedConfidence({fix_confidence_, answer.confidence});
+  confirmed_at_m_ = odometry_m_;
+  challengers_.clear();
 }
 
 std::vector<FixFilter::Hypothesis> FixFilter::Agreeing(const std::vector<Hypothesis>& pool,
@@ -158,7 +178,8 @@ void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypoth
   std::vector<double> confidences{latest.confidence};
   for (const Hypothesis& h : agreeing) confidences.push_back(h.confidence);
   status_ = FixStatus::kFixed;
-  T_world_odom_ = latest.T_world_odom;
+  T_world_odom_ = latest.T_world_odom;  // the newest answer carries the least odometry drift
+  fix_variance_m2_ = 0.25 * policy_.agree_m * policy_.agree_m;
   fix_confidence_ = CombinedConfidence(confidences);
   confirmed_at_m_ = odometry_m_;
   hypotheses_.clear();

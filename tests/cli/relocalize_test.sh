@@ -16,7 +16,7 @@ check "relocalize (a)" "$keyplace" relocalize --map "$work/map.kpm" --log "$log"
   --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png"
 check "figure" test -s "$work/a.png"
 check "TSV: one row per start" test "$(($(wc -l <"$work/a.tsv") - 1))" = 12
-check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tfixed\tscans_to_fix\tdistance_to_fix_m' \
+check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_fix_m' \
   "$work/a.tsv"
 check "JSON (a)" /usr/bin/python3 -c "
 import json,sys

@@ -124,6 +124,33 @@ TEST_F(FixedFilter, AConfidentContradictionLosesTheFix) {
   EXPECT_EQ(refix.status, FixStatus::kFixed);
 }
 
+TEST_F(FixedFilter, AfterAConfidentContradictionTheOldFixCanBeRestored) {
+  EXPECT_TRUE(filter_.Update(Answer(kWrong, 0.95), Odometry(10)).lost);
+  const RelocalizationUpdate update = filter_.Update(Answer(kTrue, 0.5), Odometry(15));
+  EXPECT_TRUE(update.new_fix);
+  const Pose2 expected = kTrue * Odometry(15);
+  EXPECT_NEAR(update.T_world_robot.x, expected.x, 1e-9);
+}
+
+TEST_F(FixedFilter, AConfirmationAveragesTheFixAndTheAnswer) {
+  // The fix (one answer's uncertainty plus 1.25 m of drift) and an answer 0.4 m ahead weigh
+  // about the same: the fix moves half way.
+  const RelocalizationUpdate update =
+      filter_.Update(Answer(kTrue * Pose2(0.4, 0.0, 0.0)), Odometry(10));
+  ASSERT_TRUE(update.confirmed);
+  const Pose2 shift = Between(kTrue * Odometry(10), update.T_world_robot);
+  EXPECT_NEAR(shift.x, 0.2, 0.01);
+  EXPECT_NEAR(shift.y, 0.0, 1e-9);
+  // Many confirmations make the fix surer, but never surer than four answers: each new answer
+  // still moves it by at least a fifth of its offset.
+  for (int scan = 15; scan <= 100; scan += 5) filter_.Update(Answer(kTrue), Odometry(scan));
+  const RelocalizationUpdate last =
+      filter_.Update(Answer(kTrue * Pose2(0.5, 0.0, 0.0)), Odometry(105));
+  const Pose2 moved = Between(kTrue * Odometry(105), last.T_world_robot);
+  EXPECT_GE(moved.x, 0.5 / 5 - 1e-6);
+  EXPECT_LT(moved.x, 0.25);
+}
+
 TEST_F(FixedFilter, ContradictionsThatAgreeReplaceTheFix) {
   filter_.Update(Answer(kWrong, 0.5), Odometry(10));
   const RelocalizationUpdate update = filter_.Update(Answer(kWrong, 0.5), Odometry(15));

@@ -29,11 +29,15 @@ struct RelocalizationOptions {
   double revisit_m = 1.5;  // a start has a revisit when its path comes this close to a map scan
   double revisit_deg = 45.0;
   double confident = 0.9;  // a fix at least this confident is "confident"
+  // A fix is checked at the nearest scan with a truth pose at most this many scans away
+  // (evaluation.truth_max_gap_scans); fixes with none are not counted.
+  int truth_max_gap_scans = 50;
 };
 
 /// One fix the relocalizer reported (at an update where a query was answered).
 struct FixEvent {
-  int scan = 0;  // query-log scan (index into the log's scans)
+  int scan = 0;          // query-log scan the fix was reported at (index into the log's scans)
+  int checked_scan = 0;  // the scan it was checked at (the nearest with a truth pose)
   Pose2 T_world_robot;
   Pose2 truth;
   double confidence = 0.0;
@@ -46,9 +50,11 @@ struct StartRecord {
   int start_scan = 0;
   int end_scan = 0;      // one past the last scan fed
   bool revisit = false;  // the path before the cap passes a map scan the localizer may match
+  double distance_to_revisit_m = 0.0;  // odometry distance to the first such scan
   bool fixed = false;
   int scans_to_fix = 0;  // scans fed up to and including the first fix
   double distance_to_fix_m = 0.0;
+  bool first_fix_checked = false;  // a truth pose was near enough to check it
   bool first_fix_correct = false;
   int answers = 0;           // queries answered
   int answers_accepted = 0;  // of them accepted by the place recognizer
@@ -76,6 +82,10 @@ struct RelocalizationSummary {
   double distance_to_fix_median_m = 0.0;  // over fixed starts
   double distance_to_fix_p90_m = 0.0;
   double scans_to_fix_median = 0.0;
+  // From the first scan the map has seen to the first fix (starts with a revisit that were fixed):
+  // what the localizer adds to the wait for a known place.
+  double distance_after_revisit_median_m = 0.0;
+  double distance_after_revisit_p90_m = 0.0;
   double update_seconds_mean = 0.0;  // per AddScan with keypoints given, over all updates
   double update_seconds_max = 0.0;
   std::size_t lost_signals = 0;  // the two below, and those with no truth to tell

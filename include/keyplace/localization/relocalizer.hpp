@@ -89,6 +89,7 @@ class FixFilter {
   std::vector<Hypothesis> Agreeing(const std::vector<Hypothesis>& pool,
                                    const Hypothesis& hypothesis, const Pose2& T_odom_robot) const;
   void Forget(std::vector<Hypothesis>& pool) const;  // drops those older than window_m
+  void Confirm(const Hypothesis& answer, const Pose2& T_odom_robot);
   void DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest,
                   RelocalizationUpdate& update);
   void DeclareLost(RelocalizationUpdate& update);
@@ -101,7 +102,8 @@ class FixFilter {
   std::vector<Hypothesis> challengers_;  // accepted answers contradicting the fix
   Pose2 T_world_odom_;                   // the fix
   double fix_confidence_ = 0.0;
-  double confirmed_at_m_ = 0.0;  // odometry distance of the last confirmation
+  double fix_variance_m2_ = 0.0;  // of the fix's position at its last confirmation
+  double confirmed_at_m_ = 0.0;   // odometry distance of the last confirmation
 };
 
 class Relocalizer {
