@@ -1,13 +1,17 @@
-// Unit tests of the report's plan: the kidnapped robot's steps (keyplace relocalize).
+// Unit tests of the report's plan and of a table drawn from a hand-made artefact: the kidnapped
+// robot's steps (keyplace relocalize) and its table.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "report_context.hpp"
 #include "report_plan.hpp"
+#include "report_tables.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -100,6 +104,41 @@ TEST(ReportPlanTest, RelocalizeStepsWithoutDataAreSkipped) {
               "needs " + ReportArtefacts::Map(settings, "fr079") + ", which does not exist");
   }
   fs::remove_all(dir);
+}
+
+TEST(ReportTablesTest, KidnappedRobotTableRendersTheJsonAndNamesWhatIsMissing) {
+  const fs::path dir = fs::temp_directory_path() / "keyplace_report_tables_test";
+  fs::remove_all(dir);
+  ReportContext context;
+  context.settings.data_dir = (dir / "data").string();
+  context.settings.work_dir = (dir / "work").string();
+  context.settings.datasets = {"fr079"};
+  context.steps = PlanReport(context.settings);
+  context.outcomes.resize(context.steps.size());
+  const std::string path = ReportArtefacts::Relocalize(context.settings, "fr079", false);
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << R"({"starts": 50, "starts_with_revisit": 31, "fixed_fraction": 0.871,
+    "wrong_fixes": 3, "fixes": 412, "wrong_fix_rate": 0.00728, "distance_to_fix_median_m": 4.26,
+    "distance_to_fix_p90_m": 17.94, "distance_after_revisit_median_m": 1.35,
+    "update_seconds_mean": 0.01234, "update_seconds_max": 0.2, "lost_signals": 5,
+    "lost_on_correct_track": 1, "lost_on_wrong_track": 3, "query_log_is_map_log": true,
+    "exclude_shared_scans": true})";
+  const std::string html = RelocalizationTable(context);
+  fs::remove_all(dir);
+  EXPECT_NE(html.find("<h3 id=\"relocalize\">Kidnapped robot (keyplace relocalize, strict "
+                      "preset)</h3>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<tr><th>FR079</th><td class=\"text\">the map's own log, shared-scan "
+                      "exclusion</td><td>50 (31)</td><td>0.871</td><td>3 / 412 (0.0073)</td>"
+                      "<td>4.3</td><td>17.9</td><td>1.4</td><td>5 (1 / 3)</td><td>12.34</td></tr>"),
+            std::string::npos)
+      << html;
+  // The raw log's row says how to make it.
+  EXPECT_NE(html.find("<tr><th>FR079_r</th><td colspan=\"9\" class=\"missing\">not computed: run "
+                      "<code>keyplace relocalize --map "),
+            std::string::npos)
+      << html;
 }
 
 }  // namespace
