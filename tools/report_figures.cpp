@@ -1,5 +1,6 @@
 // The report's figure sections: maps (Figures 3-5), stability (6-7, drawn here), the sweeps
-// (8-9, drawn here from the sweep results) and SLAM (10-12, drawn by keyplace slam).
+// (8-9, drawn here from the sweep results), the kidnapped robot (drawn by keyplace relocalize) and
+// SLAM (10-12, drawn by keyplace slam).
 
 #include <exception>
 #include <filesystem>
@@ -146,6 +147,29 @@ std::string Figure9(ReportContext& context) {
     }
   }
   if (!any) html += MissingHtml("FR079 is not among the report's data sets");
+  return html;
+}
+
+std::string RelocalizationFigures(const ReportContext& context) {
+  std::string html =
+      "<p>Kidnapped robot, the map's scan positions (grey) and for every start its true path to "
+      "its first fix (blue), the start (black), the first fix where the localizer put the robot "
+      "(green when correct) and every wrong fix (red). From <code>keyplace relocalize "
+      "--figure</code>.</p>\n";
+  for (const std::string& base : context.settings.datasets) {
+    const DatasetFiles f = FilesOf(context.settings, base);
+    html += "<div class=\"grid2\">";
+    for (const bool raw : {false, true}) {
+      const std::string name = HtmlEscape(raw ? f.name + "_r" : f.name);
+      const std::string png = A::RelocalizePng(context.settings, base, raw);
+      html += FigureHtml(png,
+                         "Kidnapped robot (ours), " + name +
+                             (raw ? ": raw log, ICP odometry, against the corrected map"
+                                  : ": corrected log against its own map"),
+                         "kidnapped robot, " + name + ": " + HowToMake(context, png));
+    }
+    html += "</div>\n";
+  }
   return html;
 }
 

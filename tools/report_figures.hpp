@@ -20,6 +20,10 @@ std::string Figure8(ReportContext& context);
 /// Figure 9: precision and recall over mu and gamma_min (FR079), drawn from the sweep results.
 std::string Figure9(ReportContext& context);
 
+/// The kidnapped robot's figures (drawn by keyplace relocalize --figure), corrected and raw log of
+/// each data set.
+std::string RelocalizationFigures(const ReportContext& context);
+
 /// Figures 10-12: SLAM on the raw logs (drawn by keyplace slam --figures).
 std::string SlamFigures(const ReportContext& context);
 

@@ -84,18 +84,20 @@ std::string PageHeader(const ReportContext& context, double run_seconds) {
       ran, done, skipped, failed, run_seconds);
   if (context.settings.quick) {
     html +=
-        "<p class=\"missing\">Quick mode (<code>--quick</code>): 20 queries instead of 500 and "
-        "reduced sweep grids. The numbers are not comparable with the paper's.</p>\n";
+        "<p class=\"missing\">Quick mode (<code>--quick</code>): 20 queries instead of 500, 6 "
+        "kidnapped-robot starts instead of 50 and reduced sweep grids. The numbers are not "
+        "comparable with the paper's.</p>\n";
   }
   html +=
       "<p>Contents: <a href=\"#maps\">Figures 3–5</a> · <a href=\"#stability\">Figures 6–7</a> · "
       "<a href=\"#mapping\">Table II, Figure 8, Table VI</a> · <a href=\"#place\">Tables III–V, "
-      "Figure 9, Tables VII–VIII</a> · <a href=\"#slam\">Table IX, loops, Figures 10–12</a> · "
+      "Figure 9, Tables VII–VIII</a> · <a href=\"#relocalize\">kidnapped robot</a> · "
+      "<a href=\"#slam\">Table IX, loops, Figures 10–12</a> · "
       "<a href=\"#table10\">Table X</a> · <a href=\"#commands\">commands</a></p>\n";
   return html;
 }
 
-// Global localization: Table V, Figure 9, Tables III, IV, VII and VIII.
+// Global localization: Table V, Figure 9, Tables III, IV, VII and VIII, the kidnapped robot.
 std::string PlaceSection(ReportContext& context) {
   std::string html = "<h2 id=\"place\">Global localization (Sections 5.2 and 6.2.1)</h2>\n";
   html += TableV();
@@ -107,6 +109,8 @@ std::string PlaceSection(ReportContext& context) {
                             "Table VII — raw (ICP) queries against the corrected map, λ = 0.05 m");
   html += LocalizationTable(context, true, 0.1, "table8",
                             "Table VIII — raw (ICP) queries against the corrected map, λ = 0.1 m");
+  html += RelocalizationTable(context);
+  html += RelocalizationFigures(context);
   return html;
 }
 

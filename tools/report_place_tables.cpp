@@ -1,8 +1,10 @@
 // The report's place recognition tables: V (parameters), III, IV, VII, VIII (global
-// localization) and X (P_GL / P_CL beside TIP-FLIRT).
+// localization), X (P_GL / P_CL beside TIP-FLIRT) and the kidnapped robot (keyplace relocalize).
 
 #include <cmath>
+#include <cstddef>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -112,6 +114,55 @@ ComparedGroup TipFlirtGroup(const ReportContext& context, const std::string& bas
   return tip;
 }
 
+// The flag `key` of `json` (read from `path`), nullopt when missing or null; throws
+// std::invalid_argument when the value is no boolean.
+std::optional<bool> Flag(const Json& json, const std::string& key, const std::string& path) {
+  if (!json.contains(key) || json[key].is_null()) return std::nullopt;
+  if (!json[key].is_boolean()) {
+    throw std::invalid_argument(path + ": field '" + key + "' is no boolean");
+  }
+  return json[key].get<bool>();
+}
+
+// A cell's number with `digits` decimals ("–" when not measured), `scale` applied.
+std::string Cell(std::optional<double> value, int digits, double scale = 1.0) {
+  return value ? fmt::format("{:.{}f}", scale * *value, digits) : std::string("–");
+}
+
+// The protocol of a relocalize run, as keyplace relocalize prints it.
+std::string ProtocolText(const Json& json, const std::string& path) {
+  const std::optional<bool> own_log = Flag(json, "query_log_is_map_log", path);
+  const std::optional<bool> excluded = Flag(json, "exclude_shared_scans", path);
+  if (!own_log) return "–";
+  if (!*own_log) return "another recording";
+  if (excluded && *excluded) return "the map's own log, shared-scan exclusion";
+  return "the map's own log, nothing excluded";
+}
+
+// One row of the kidnapped-robot table from the relocalize JSON at `path`.
+std::string RelocalizationRow(const ReportContext& context, const std::string& name,
+                              const std::string& path, std::size_t columns) {
+  const std::optional<Json> json = LoadJson(path);
+  std::string html = "<tr><th>" + HtmlEscape(name) + "</th>";
+  if (!json) {
+    return html + fmt::format("<td colspan=\"{}\" class=\"missing\">not computed: {}</td></tr>\n",
+                              columns - 1, HowToMake(context, path));
+  }
+  const auto n = [&](const std::string& key) { return Number(json, key, path); };
+  html += "<td class=\"text\">" + HtmlEscape(ProtocolText(*json, path)) + "</td>";
+  html += fmt::format("<td>{} ({})</td>", Cell(n("starts"), 0), Cell(n("starts_with_revisit"), 0));
+  html += "<td>" + Cell(n("fixed_fraction"), 3) + "</td>";
+  html += fmt::format("<td>{} / {} ({})</td>", Cell(n("wrong_fixes"), 0), Cell(n("fixes"), 0),
+                      Cell(n("wrong_fix_rate"), 4));
+  html += "<td>" + Cell(n("distance_to_fix_median_m"), 1) + "</td>";
+  html += "<td>" + Cell(n("distance_to_fix_p90_m"), 1) + "</td>";
+  html += "<td>" + Cell(n("distance_after_revisit_median_m"), 1) + "</td>";
+  html += fmt::format("<td>{} ({} / {})</td>", Cell(n("lost_signals"), 0),
+                      Cell(n("lost_on_correct_track"), 0), Cell(n("lost_on_wrong_track"), 0));
+  html += "<td>" + Cell(n("update_seconds_mean"), 2, 1e3) + "</td>";
+  return html + "</tr>\n";
+}
+
 }  // namespace
 
 std::string TableV() {
@@ -190,6 +241,45 @@ std::string TableX(const ReportContext& context) {
       "corrected scan a place, single-scan queries (our re-implementation of the protocol, "
       "docs/RESULTS.md). Data reduction = 1 − compression of the localization map.",
       kColumns, groups);
+}
+
+std::string RelocalizationTable(const ReportContext& context) {
+  static const std::vector<std::string> kHeaders{"data set",
+                                                 "protocol",
+                                                 "starts (with a revisit)",
+                                                 "fixed fraction",
+                                                 "wrong fixes / fixes (rate)",
+                                                 "to first fix, median (m)",
+                                                 "to first fix, 90th pct. (m)",
+                                                 "after the first known place, median (m)",
+                                                 "lost signals (correct / wrong track)",
+                                                 "update, mean (ms)"};
+  std::string html =
+      "<h3 id=\"relocalize\">Kidnapped robot (keyplace relocalize, strict preset)</h3>\n"
+      "<table><thead><tr>";
+  for (const std::string& header : kHeaders) html += "<th>" + HtmlEscape(header) + "</th>";
+  html += "</tr></thead><tbody>\n";
+  for (const std::string& base : context.settings.datasets) {
+    const DatasetFiles f = FilesOf(context.settings, base);
+    for (const bool raw : {false, true}) {
+      html += RelocalizationRow(context, raw ? f.name + "_r" : f.name,
+                                A::Relocalize(context.settings, base, raw), kHeaders.size());
+    }
+  }
+  html += "</tbody></table>\n";
+  html +=
+      "<p class=\"caption\">Not in the paper (docs/LOCALIZATION.md). From each start spread over "
+      "the query log the relocalizer, knowing nothing, is fed scans and odometry until it declares "
+      "a fix or gives up; every fix it reports over the following distance is checked against the "
+      "truth (0.5 m, 10°). FR079: the corrected log against its own map, map submaps sharing a "
+      "scan with the query excluded; FR079_r: the raw log with ICP odometry against the corrected "
+      "map. A start has a revisit when its true path passes a map scan it may be matched with; "
+      "fixed fraction counts those starts only. After the first known place: distance from where "
+      "the path first passes such a map scan to the fix. Lost signals: the localizer said it was "
+      "lost, on a correct or a wrong track (the rest had no truth to tell). Update: time per scan "
+      "with its keypoints given. The "
+      "paper has no such figures, so nothing is coloured.</p>\n";
+  return html;
 }
 
 }  // namespace keyplace::cli

@@ -152,6 +152,14 @@ std::string ReportArtefacts::TipFlirt(const ReportSettings& s, const std::string
   return Join(s.work_dir, "localize/" + base + "-tip-flirt" +
                               (mu == 10 ? "" : fmt::format("-mu{}", mu)) + ".json");
 }
+std::string ReportArtefacts::Relocalize(const ReportSettings& s, const std::string& base,
+                                        bool raw) {
+  return Join(s.work_dir, "relocalize/" + base + (raw ? "-raw" : "") + ".json");
+}
+std::string ReportArtefacts::RelocalizePng(const ReportSettings& s, const std::string& base,
+                                           bool raw) {
+  return Join(s.work_dir, "relocalize/" + base + (raw ? "-raw" : "") + ".png");
+}
 std::string ReportArtefacts::Fig8Dir(const ReportSettings& s, const std::string& base) {
   return Join(s.work_dir, "sweeps/fig8-" + base);
 }
@@ -167,6 +175,7 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
   using A = ReportArtefacts;
   std::vector<ReportStep> steps;
   const std::string n_pos = s.quick ? "20" : "500";
+  const std::string starts = s.quick ? "6" : "50";
   const std::string threads = std::to_string(s.threads);
   const std::vector<std::string> presets{"default", "paper"};
   const std::vector<double> lambdas{0.05, 0.1};
@@ -242,6 +251,31 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
             "place.min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
            {log},
            {A::TipFlirt(s, base, 5)}});
+    }
+    // The kidnapped robot (not in the paper): the corrected log against its own map with the
+    // shared-scan exclusion, and the raw log with ICP odometry against the corrected map.
+    for (const bool raw_queries : {false, true}) {
+      const std::string json = A::Relocalize(s, base, raw_queries);
+      const std::string png = A::RelocalizePng(s, base, raw_queries);
+      std::vector<std::string> args{"relocalize", "--map", A::Map(s, base)};
+      std::vector<std::string> needs{A::Map(s, base)};
+      if (raw_queries) {
+        args.insert(args.end(),
+                    {"--log", raw, "--poses", "icp", "--truth", log, "--index", f.index});
+        needs.insert(needs.end(), {raw, log, f.index});
+      } else {
+        args.insert(args.end(), {"--log", log, "--self-match", "shared-scan"});
+        needs.push_back(log);
+      }
+      args.insert(args.end(), {"--starts", starts, "--json", json, "--figure", png});
+      steps.push_back(
+          {"relocalize-" + base + (raw_queries ? "-raw" : ""),
+           raw_queries
+               ? "Kidnapped robot, " + f.name + "_r (ICP odometry) against the corrected map"
+               : "Kidnapped robot, " + f.name + " against its own map (shared-scan exclusion)",
+           args,
+           needs,
+           {json, png}});
     }
     // Figure 8: mapping criteria over s_min x l_g.
     const std::string fig8 = A::Fig8Dir(s, base);

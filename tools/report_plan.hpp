@@ -40,6 +40,9 @@ struct ReportArtefacts {
   /// `mu` 10: the baseline's defaults (mu 10, consensus 9); 5: mu 5 and consensus 5, the setting
   /// that reproduces Tipaldi et al.'s figures (docs/PLACE.md).
   static std::string TipFlirt(const ReportSettings& s, const std::string& base, int mu = 10);
+  /// keyplace relocalize JSON and figure; `raw` queries from the raw log (ICP odometry).
+  static std::string Relocalize(const ReportSettings& s, const std::string& base, bool raw);
+  static std::string RelocalizePng(const ReportSettings& s, const std::string& base, bool raw);
   static std::string Fig8Dir(const ReportSettings& s, const std::string& base);
   static std::string Fig9Dir(const ReportSettings& s, const std::string& base,
                              const std::string& preset);

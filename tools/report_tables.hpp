@@ -27,4 +27,8 @@ std::string LocalizationTable(const ReportContext& context, bool raw, double lam
 /// Table X: P_GL and P_CL of ours and of TIP-FLIRT.
 std::string TableX(const ReportContext& context);
 
+/// The kidnapped robot (keyplace relocalize, not in the paper): one row per data set and log kind
+/// (corrected, raw), a "not computed" row when its JSON is missing.
+std::string RelocalizationTable(const ReportContext& context);
+
 }  // namespace keyplace::cli

@@ -26,7 +26,7 @@ if python3 -c "import sys; d=open(sys.argv[1],'rb').read(24); sys.exit(0 if d[:8
 else
   fail "the screenshot is not a 1280 px wide PNG"
 fi
-grep -q '6 images loaded' "$work/good.txt" && ok || fail "expected 6 images: $(cat "$work/good.txt")"
+grep -q '7 images loaded' "$work/good.txt" && ok || fail "expected 7 images: $(cat "$work/good.txt")"
 
 # The same page with its first image's data replaced by bytes that are no PNG.
 python3 - "$report/index.html" "$work/broken.html" <<'PY'

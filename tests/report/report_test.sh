@@ -35,17 +35,18 @@ skipped=$(grep -c ': skipped, needs ' "$work/first.txt")
 expect 'report written to' "$work/first.txt" "summary line"
 
 # Every table and figure section.
-for anchor in maps stability table2 fig8 table6 table5 fig9 table3 table4 table7 table8 table9 \
-              loops fig10 table10 commands; do
+for anchor in maps stability table2 fig8 table6 table5 fig9 table3 table4 table7 table8 \
+              relocalize table9 loops fig10 table10 commands; do
   expect "id=\"$anchor\"" "$page" "section $anchor"
 done
 for caption in "Figure 3 (ours)" "Figure 6 (ours)" "Figure 7 (ours)" "Figure 8 (ours), FR079" \
                "Figure 9 (ours), FR079, <code>--preset default" \
-               "Figure 9 (ours), FR079, <code>--preset paper"; do
+               "Figure 9 (ours), FR079, <code>--preset paper" \
+               "Kidnapped robot (ours), FR079: corrected log"; do
   expect "$caption" "$page" "figure caption '$caption'"
 done
 images=$(grep -o '<img src="data:image/png;base64,' "$page" | wc -l)
-[ "$images" -eq 6 ] && ok || fail "expected 6 embedded figures, found $images"
+[ "$images" -eq 7 ] && ok || fail "expected 7 embedded figures, found $images"
 # No file references: the page is self-contained.
 if grep -q '<img src="[^d]' "$page"; then fail "an image is not embedded"; else ok; fi
 # Ours beside the paper's: the paper's Table II and III rows for FR079, and our values with a
@@ -61,6 +62,11 @@ expect '<td>l_g (m)</td><td class="text">Table V</td><td>0.1</td><td>0.1</td>' "
 expect 'not computed: run <code>keyplace slam ' "$page" "slam marked not computed"
 expect 'not computed: run <code>keyplace localize --map .* --poses icp' "$page" \
   "raw localization marked not computed"
+# The kidnapped robot: the corrected log's row (6 starts) and the raw log's "not computed".
+expect '<tr><th>FR079</th><td class="text">the map.s own log, shared-scan exclusion</td><td>6 (' \
+  "$page" "kidnapped-robot row"
+expect '<tr><th>FR079_r</th><td colspan="9" class="missing">not computed: run <code>keyplace relocalize --map .* --poses icp' \
+  "$page" "raw kidnapped robot marked not computed"
 expect 'Quick mode' "$page" "quick-mode warning"
 if grep -q '<h2>Warnings' "$page"; then fail "the page has warnings"; else ok; fi
 

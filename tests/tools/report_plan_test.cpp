@@ -1,0 +1,145 @@
+// Unit tests of the report's plan and of a table drawn from a hand-made artefact: the kidnapped
+// robot's steps (keyplace relocalize) and its table.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "report_context.hpp"
+#include "report_plan.hpp"
+#include "report_tables.hpp"
+
+namespace keyplace::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+ReportSettings Settings(bool quick) {
+  ReportSettings settings;
+  settings.data_dir = "/data";
+  settings.work_dir = "/work";
+  settings.datasets = {"fr079", "intel"};
+  settings.quick = quick;
+  return settings;
+}
+
+// The index of the step `id` in `steps` (steps.size() when absent).
+std::size_t IndexOf(const std::vector<ReportStep>& steps, const std::string& id) {
+  const auto it =
+      std::find_if(steps.begin(), steps.end(), [&](const ReportStep& s) { return s.id == id; });
+  return static_cast<std::size_t>(it - steps.begin());
+}
+
+TEST(ReportPlanTest, RelocalizesTheCorrectedLogAgainstItsOwnMap) {
+  const std::vector<ReportStep> steps = PlanReport(Settings(false));
+  const std::size_t k = IndexOf(steps, "relocalize-fr079");
+  ASSERT_LT(k, steps.size());
+  const ReportStep& step = steps[k];
+  EXPECT_EQ(CommandLine(step),
+            "keyplace relocalize --map /work/maps/fr079.kpm --log /data/fr079-corrected.log.gz "
+            "--self-match shared-scan --starts 50 --json /work/relocalize/fr079.json --figure "
+            "/work/relocalize/fr079.png");
+  EXPECT_EQ(step.needs,
+            (std::vector<std::string>{"/work/maps/fr079.kpm", "/data/fr079-corrected.log.gz"}));
+  EXPECT_EQ(step.outputs, (std::vector<std::string>{"/work/relocalize/fr079.json",
+                                                    "/work/relocalize/fr079.png"}));
+  EXPECT_EQ(step.outputs[0], ReportArtefacts::Relocalize(Settings(false), "fr079", false));
+  EXPECT_EQ(step.outputs[1], ReportArtefacts::RelocalizePng(Settings(false), "fr079", false));
+  // The map it reads is made before it.
+  EXPECT_LT(IndexOf(steps, "map-fr079"), k);
+}
+
+TEST(ReportPlanTest, RelocalizesTheRawLogWithIcpOdometryAgainstTheCorrectedMap) {
+  const std::vector<ReportStep> steps = PlanReport(Settings(false));
+  const std::size_t k = IndexOf(steps, "relocalize-intel-raw");
+  ASSERT_LT(k, steps.size());
+  const ReportStep& step = steps[k];
+  EXPECT_EQ(CommandLine(step),
+            "keyplace relocalize --map /work/maps/intel.kpm --log /data/intel-raw.log.gz --poses "
+            "icp --truth /data/intel-corrected.log.gz --index /data/intel-raw-to-corrected.tsv "
+            "--starts 50 --json /work/relocalize/intel-raw.json --figure "
+            "/work/relocalize/intel-raw.png");
+  EXPECT_EQ(step.needs, (std::vector<std::string>{"/work/maps/intel.kpm", "/data/intel-raw.log.gz",
+                                                  "/data/intel-corrected.log.gz",
+                                                  "/data/intel-raw-to-corrected.tsv"}));
+  EXPECT_EQ(step.outputs, (std::vector<std::string>{"/work/relocalize/intel-raw.json",
+                                                    "/work/relocalize/intel-raw.png"}));
+  EXPECT_LT(IndexOf(steps, "map-intel"), k);
+  // One step of each kind per data set.
+  EXPECT_EQ(std::count_if(steps.begin(), steps.end(),
+                          [](const ReportStep& s) { return s.args[0] == "relocalize"; }),
+            4);
+}
+
+TEST(ReportPlanTest, QuickReportsUseFewStarts) {
+  for (const ReportStep& step : PlanReport(Settings(true))) {
+    if (step.args[0] != "relocalize") continue;
+    const auto starts = std::find(step.args.begin(), step.args.end(), "--starts");
+    ASSERT_NE(starts, step.args.end()) << step.id;
+    ASSERT_NE(starts + 1, step.args.end()) << step.id;
+    EXPECT_EQ(*(starts + 1), "6") << step.id;
+  }
+}
+
+TEST(ReportPlanTest, RelocalizeStepsWithoutDataAreSkipped) {
+  const fs::path dir = fs::temp_directory_path() / "keyplace_report_plan_test";
+  fs::remove_all(dir);
+  ReportSettings settings = Settings(false);
+  settings.data_dir = (dir / "data").string();
+  settings.work_dir = (dir / "work").string();
+  settings.datasets = {"fr079"};
+  std::vector<ReportStep> steps;
+  for (const ReportStep& step : PlanReport(settings)) {
+    if (step.args[0] == "relocalize") steps.push_back(step);
+  }
+  ASSERT_EQ(steps.size(), 2u);
+  const std::vector<StepOutcome> outcomes = RunSteps(settings, steps, "/nonexistent", false);
+  for (const StepOutcome& outcome : outcomes) {
+    EXPECT_EQ(outcome.state, StepState::kSkipped);
+    EXPECT_EQ(outcome.message,
+              "needs " + ReportArtefacts::Map(settings, "fr079") + ", which does not exist");
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ReportTablesTest, KidnappedRobotTableRendersTheJsonAndNamesWhatIsMissing) {
+  const fs::path dir = fs::temp_directory_path() / "keyplace_report_tables_test";
+  fs::remove_all(dir);
+  ReportContext context;
+  context.settings.data_dir = (dir / "data").string();
+  context.settings.work_dir = (dir / "work").string();
+  context.settings.datasets = {"fr079"};
+  context.steps = PlanReport(context.settings);
+  context.outcomes.resize(context.steps.size());
+  const std::string path = ReportArtefacts::Relocalize(context.settings, "fr079", false);
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << R"({"starts": 50, "starts_with_revisit": 31, "fixed_fraction": 0.871,
+    "wrong_fixes": 3, "fixes": 412, "wrong_fix_rate": 0.00728, "distance_to_fix_median_m": 4.26,
+    "distance_to_fix_p90_m": 17.94, "distance_after_revisit_median_m": 1.35,
+    "update_seconds_mean": 0.01234, "update_seconds_max": 0.2, "lost_signals": 5,
+    "lost_on_correct_track": 1, "lost_on_wrong_track": 3, "query_log_is_map_log": true,
+    "exclude_shared_scans": true})";
+  const std::string html = RelocalizationTable(context);
+  fs::remove_all(dir);
+  EXPECT_NE(html.find("<h3 id=\"relocalize\">Kidnapped robot (keyplace relocalize, strict "
+                      "preset)</h3>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<tr><th>FR079</th><td class=\"text\">the map's own log, shared-scan "
+                      "exclusion</td><td>50 (31)</td><td>0.871</td><td>3 / 412 (0.0073)</td>"
+                      "<td>4.3</td><td>17.9</td><td>1.4</td><td>5 (1 / 3)</td><td>12.34</td></tr>"),
+            std::string::npos)
+      << html;
+  // The raw log's row says how to make it.
+  EXPECT_NE(html.find("<tr><th>FR079_r</th><td colspan=\"9\" class=\"missing\">not computed: run "
+                      "<code>keyplace relocalize --map "),
+            std::string::npos)
+      << html;
+}
+
+}  // namespace
+}  // namespace keyplace::cli
