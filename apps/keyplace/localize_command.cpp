@@ -21,22 +21,19 @@
 #include "keyplace/store/map_file.hpp"
 #include "localize_output.hpp"
 #include "paper_tables.hpp"
+#include "query_log.hpp"
 
 namespace keyplace::cli {
 namespace {
 
 struct LocalizeOptions {
+  QueryLogOptions query;
   std::string map_path;
-  std::string log_path;
-  std::string poses = "corrected";
-  std::string truth_path;
-  std::string index_path;
   std::string json_path;
   std::string queries_path;
   std::string curve_path;
   std::string baseline;
   std::string rank_by;
-  std::string scans;
   std::string reliability_path;
   ConfigOptions config;
   std::optional<int> mu;
@@ -46,7 +43,6 @@ struct LocalizeOptions {
   std::string descriptor_index;
   int n_pos = 500;
   bool exclude_shared_scans = false;
-  bool skip_bad_lines = false;
 };
 
 // The everyday flags as configuration assignments (--gamma-min sets both thresholds).
@@ -87,19 +83,11 @@ void RunLocalize(const LocalizeOptions& options) {
   SelfMatchRule rule =
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
 
-  LogInputOptions input_options;
-  input_options.reading.skip_bad_lines = options.skip_bad_lines;
-  input_options.poses = ParsePoseSource(options.poses);
-  input_options.odometry = config.odometry;
-  input_options.features = config.features;
-  ApplyScanRange(options.scans, input_options);
-  const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
-  PrintLogWarnings(inputs.log);
-  const GroundTruth truth =
-      LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans, options.truth_path,
-                      options.index_path, inputs.source_hash);
+  const QueryLog query = ReadQueryLog(options.query, config);
+  const LogInputs& inputs = query.inputs;
+  const GroundTruth& truth = query.truth;
   const std::string map_log_path =
-      options.truth_path.empty() ? options.log_path : options.truth_path;
+      options.query.truth_path.empty() ? options.query.log_path : options.query.truth_path;
   const std::vector<int> starts = QueryStarts(truth, options.n_pos);
 
   std::vector<Place> places;
@@ -128,13 +116,14 @@ void RunLocalize(const LocalizeOptions& options) {
                                  [&](std::size_t done, std::size_t) { progress.Update(done); });
     progress.Finish();
   } else {
-    LogInputOptions map_options = input_options;
+    LogInputOptions map_options = query.input_options;
     map_options.poses = PoseSource::kCorrected;
     // --scans cuts the query log; the places of a --truth log are all of its scans.
     map_options.first_scan = 0;
     map_options.end_scan = LogInputOptions{}.end_scan;
-    const LogInputs map_log =
-        options.truth_path.empty() ? inputs : PrepareLogInputs(options.truth_path, map_options);
+    const LogInputs map_log = options.query.truth_path.empty()
+                                  ? inputs
+                                  : PrepareLogInputs(options.query.truth_path, map_options);
     places = ScanPlaces(map_log);
     map_scans = ScanPlacesAsSubmaps(places);
     map_description =
@@ -150,7 +139,7 @@ void RunLocalize(const LocalizeOptions& options) {
   MarkRevisitable(queries, map_scans, rule, config.evaluation, records);
 
   LocalizeReport report;
-  report.log_path = options.log_path;
+  report.log_path = options.query.log_path;
   report.map_description = map_description;
   report.pose_source = inputs.pose_source;
   report.log_scans = inputs.log.scans.size();
@@ -177,7 +166,7 @@ void RunLocalize(const LocalizeOptions& options) {
     nlohmann::json json = LocalizeJson(report, records);
     json["map"] = baseline ? "" : options.map_path;
     json["baseline"] = options.baseline;
-    json["truth"] = options.truth_path;
+    json["truth"] = options.query.truth_path;
     json["places"] = recognizer.places().size();
     json["config"] = ConfigJson(config);
     json["seconds_total"] = SecondsSince(start);
@@ -197,23 +186,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
       "confidence's reliability diagram, or the TIP-FLIRT single-scan baseline.");
   command->add_option("--map", options->map_path, "Map file (.kpm) built from the corrected log")
       ->check(CLI::ExistingFile);
-  command->add_option("--log", options->log_path, "Query log (corrected or raw)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  command
-      ->add_option("--poses", options->poses,
-                   "Query poses: corrected (the log's), icp (scan matching on odometry) or "
-                   "odometry")
-      ->check(CLI::IsMember({"corrected", "icp", "odometry"}))
-      ->capture_default_str();
-  command
-      ->add_option("--truth", options->truth_path,
-                   "Corrected log giving the ground truth of a raw query log")
-      ->check(CLI::ExistingFile);
-  command
-      ->add_option("--index", options->index_path,
-                   "raw_index<TAB>corrected_index file relating --log to --truth")
-      ->check(CLI::ExistingFile);
+  AddQueryLogOptions(command, options->query,
+                     "Query poses: corrected (the log's), icp (scan matching on odometry) or "
+                     "odometry");
   command->add_option("--mu", options->mu, "Alias of --set place.min_pairs=N (default 10)");
   command->add_option("--gamma-min", options->gamma_min,
                       "Sets place.min_gamma and place.min_gamma_all_scans (defaults 0.4 and 0.15; "
@@ -228,9 +203,6 @@ void RegisterLocalizeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"dense", "kdtree", "none"}));
   AddConfigOptions(command, options->config);
   command->add_option("--n-pos", options->n_pos, "Number of queries")->capture_default_str();
-  command->add_option("--scans", options->scans,
-                      "Queries from the scans C:D of --log only (e.g. 700: after a map of "
-                      "--scans 0:700, the time split); scan indices stay those of the whole file");
   command->add_flag("--exclude-shared-scans", options->exclude_shared_scans,
                     "Skip every map submap sharing a scan with the query (default: only submaps "
                     "built from exactly the query's scans, the paper's rule). Either rule applies "
@@ -253,7 +225,6 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--reliability", options->reliability_path,
                       "Write the reliability diagram (TSV): accepted answers in 10 confidence "
                       "bins, mean confidence and observed precision per bin");
-  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   command->callback([options] { RunLocalize(*options); });
 }
 

@@ -15,18 +15,15 @@
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "query_log.hpp"
 #include "relocalize_output.hpp"
 
 namespace keyplace::cli {
 namespace {
 
 struct RelocalizeOptions {
+  QueryLogOptions query;
   std::string map_path;
-  std::string log_path;
-  std::string poses = "corrected";
-  std::string truth_path;
-  std::string index_path;
-  std::string scans;
   std::string self_match = "shared-scan";
   std::string json_path;
   std::string tsv_path;
@@ -34,7 +31,6 @@ struct RelocalizeOptions {
   std::string figure_path;
   ConfigOptions config;
   int starts = 50;
-  bool skip_bad_lines = false;
 };
 
 RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config& config,
@@ -57,21 +53,13 @@ void RunRelocalize(const RelocalizeOptions& options) {
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);
 
-  LogInputOptions input_options;
-  input_options.reading.skip_bad_lines = options.skip_bad_lines;
-  input_options.poses = ParsePoseSource(options.poses);
-  input_options.odometry = config.odometry;
-  input_options.features = config.features;
-  ApplyScanRange(options.scans, input_options);
-  const LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
-  PrintLogWarnings(inputs.log);
-  const GroundTruth truth =
-      LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans, options.truth_path,
-                      options.index_path, inputs.source_hash);
+  const QueryLog query = ReadQueryLog(options.query, config);
+  const LogInputs& inputs = query.inputs;
+  const GroundTruth& truth = query.truth;
 
   RelocalizeReport report;
   report.map_path = options.map_path;
-  report.log_path = options.log_path;
+  report.log_path = options.query.log_path;
   report.first_scan = inputs.first_scan;
   report.end_scan = inputs.first_scan + inputs.log.scans.size();
   report.pose_source = inputs.pose_source;
@@ -113,27 +101,9 @@ void RegisterRelocalizeCommand(CLI::App& app) {
   command->add_option("--map", options->map_path, "Map file (.kpm)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--log", options->log_path, "Query log (corrected or raw)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  command
-      ->add_option("--poses", options->poses,
-                   "Odometry fed to the localizer: corrected (the log's), icp (scan matching on "
-                   "odometry) or odometry")
-      ->check(CLI::IsMember({"corrected", "icp", "odometry"}))
-      ->capture_default_str();
-  command
-      ->add_option("--truth", options->truth_path,
-                   "Corrected log giving the ground truth of a raw query log")
-      ->check(CLI::ExistingFile);
-  command
-      ->add_option("--index", options->index_path,
-                   "raw_index<TAB>corrected_index file relating --log to --truth")
-      ->check(CLI::ExistingFile);
-  command
-      ->add_option("--scans", options->scans,
-                   "Query scans A:B of the log (e.g. 700: when the map was built from 0:700)")
-      ->capture_default_str();
+  AddQueryLogOptions(command, options->query,
+                     "Odometry fed to the localizer: corrected (the log's), icp (scan matching "
+                     "on odometry) or odometry");
   command->add_option("--starts", options->starts, "Number of starts")->capture_default_str();
   command
       ->add_option("--self-match", options->self_match,
@@ -152,7 +122,6 @@ void RegisterRelocalizeCommand(CLI::App& app) {
                       "Write one TSV row per fix reported (pose, truth, error) to FILE");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
-  command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   command->callback([options] { RunRelocalize(*options); });
 }
 

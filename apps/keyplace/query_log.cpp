@@ -1,0 +1,43 @@
+#include "query_log.hpp"
+
+#include "cli_support.hpp"
+
+namespace keyplace::cli {
+
+void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
+                        const std::string& poses_help) {
+  command->add_option("--log", options.log_path, "Query log (corrected or raw)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--poses", options.poses, poses_help)
+      ->check(CLI::IsMember({"corrected", "icp", "odometry"}))
+      ->capture_default_str();
+  command
+      ->add_option("--truth", options.truth_path,
+                   "Corrected log giving the ground truth of a raw query log")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--index", options.index_path,
+                   "raw_index<TAB>corrected_index file relating --log to --truth")
+      ->check(CLI::ExistingFile);
+  command->add_option("--scans", options.scans,
+                      "Query scans A:B of the log (a time split: the map of --scans 0:A, the "
+                      "queries from A:)");
+  command->add_flag("--skip-bad-lines", options.skip_bad_lines, kSkipBadLinesHelp);
+}
+
+QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {
+  QueryLog query;
+  query.input_options.reading.skip_bad_lines = options.skip_bad_lines;
+  query.input_options.poses = ParsePoseSource(options.poses);
+  query.input_options.odometry = config.odometry;
+  query.input_options.features = config.features;
+  ApplyScanRange(options.scans, query.input_options);
+  query.inputs = PrepareLogInputs(options.log_path, query.input_options, StageProgressBar());
+  PrintLogWarnings(query.inputs.log);
+  query.truth = LoadGroundTruth(query.inputs.log, query.inputs.first_scan, query.inputs.file_scans,
+                                options.truth_path, options.index_path, query.inputs.source_hash);
+  return query;
+}
+
+}  // namespace keyplace::cli

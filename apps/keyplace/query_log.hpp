@@ -1,0 +1,37 @@
+#pragma once
+// The query log of the localization commands (localize, relocalize): its options (--log, --poses,
+// --truth, --index, --scans, --skip-bad-lines) and reading it with its ground truth.
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "keyplace/config/config.hpp"
+#include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
+
+namespace keyplace::cli {
+
+struct QueryLogOptions {
+  std::string log_path;
+  std::string poses = "corrected";
+  std::string truth_path;
+  std::string index_path;
+  std::string scans;
+  bool skip_bad_lines = false;
+};
+
+/// Registers the options; `poses_help` says what the poses are used for.
+void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options, const std::string& poses_help);
+
+struct QueryLog {
+  LogInputOptions input_options;  // as the log was read (for more logs read alike)
+  LogInputs inputs;
+  GroundTruth truth;
+};
+
+/// Reads the log (poses, keypoints, the --scans cut) with progress, prints its warnings and loads
+/// its ground truth (its own corrected poses, or --truth through --index).
+QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config);
+
+}  // namespace keyplace::cli
