@@ -89,6 +89,11 @@ void RunLocalize(const LocalizeOptions& options) {
   const std::string map_log_path =
       options.query.truth_path.empty() ? options.query.log_path : options.query.truth_path;
   const std::vector<int> starts = QueryStarts(truth, options.n_pos);
+  if (starts.size() < static_cast<std::size_t>(options.n_pos)) {
+    fmt::print(stderr,
+               "keyplace: note: --n-pos {} capped to the {} query scans with a truth pose\n",
+               options.n_pos, starts.size());
+  }
 
   std::vector<Place> places;
   std::vector<LocalizationQuery> queries;

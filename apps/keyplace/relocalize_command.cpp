@@ -72,6 +72,10 @@ void RunRelocalize(const RelocalizeOptions& options) {
   report.records = RunRelocalization(map, inputs, truth, ToLocalizerConfig(config), report.options,
                                      [&](std::size_t done, std::size_t) { progress.Update(done); });
   progress.Finish();
+  if (report.records.size() < static_cast<std::size_t>(options.starts)) {
+    fmt::print(stderr, "keyplace: note: --starts {} capped to the {} scans with a truth pose\n",
+               options.starts, report.records.size());
+  }
   report.summary = SummarizeRelocalization(report.records, report.options);
   report.seconds_total = SecondsSince(start);
   PrintRelocalizeReport(report, map);

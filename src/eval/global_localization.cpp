@@ -42,12 +42,11 @@ std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos) {
     if (truth.Has(k)) eligible.push_back(static_cast<int>(k));
   }
   if (eligible.empty()) throw std::invalid_argument("no query scan has a ground-truth pose");
+  // More queries than scans would repeat starts (the same query counted twice): cap instead.
+  const std::size_t count = std::min(static_cast<std::size_t>(n_pos), eligible.size());
   std::vector<int> starts;
-  starts.reserve(static_cast<std::size_t>(n_pos));
-  for (int i = 0; i < n_pos; ++i) {
-    starts.push_back(
-        eligible[static_cast<std::size_t>(i) * eligible.size() / static_cast<std::size_t>(n_pos)]);
-  }
+  starts.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) starts.push_back(eligible[i * eligible.size() / count]);
   return starts;
 }
 

@@ -52,6 +52,16 @@ assert all(int(r['start_scan']) >= 0 for r in rows)
 assert len(rows) == 8
 " "$work/b.tsv"
 
+# More starts than scans: every scan once, with a note.
+check "starts capped" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" --scans 0:30 \
+  --starts 100 --json "$work/capped.json"
+cp "$work/err" "$work/capped.err"
+check "capped: 30 starts" /usr/bin/python3 -c "
+import json,sys
+assert json.load(open(sys.argv[1]))['starts'] == 30
+" "$work/capped.json"
+check "capped: note" grep -q "capped to the 30" "$work/capped.err"
+
 fails_with "no starts" "--starts" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
   --starts 0
 fails_with "bad range" "--scans" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \

@@ -72,6 +72,10 @@ TEST(GroundTruth, HashOfTheLogFileAndQueryIndicesOfACut) {
   // The query starts are positions in the cut log; their truth scans are file scans.
   const std::vector<int> starts = QueryStarts(truth, 4);
   EXPECT_EQ(starts, (std::vector<int>{0, 10, 20, 30}));
+  // More queries than scans with a truth pose: every scan once, none repeated.
+  std::vector<int> all(40);
+  for (int k = 0; k < 40; ++k) all[static_cast<std::size_t>(k)] = k;
+  EXPECT_EQ(QueryStarts(truth, 500), all);
 }
 
 TEST(TruthIsMapLog, ByFingerprintElseByFileName) {

@@ -38,7 +38,8 @@ struct LocalizationQuery {
 /// Progress: (queries done, queries in all).
 using QueryProgress = std::function<void(std::size_t, std::size_t)>;
 
-/// The start scans of n_pos queries: equally spaced over the scans that have a truth pose.
+/// The start scans of n_pos queries: equally spaced over the scans that have a truth pose, all
+/// distinct (fewer than n_pos when fewer scans have one).
 std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos);
 
 /// The submap queries of Algorithm 4 from `starts`, built with the map's mapping configuration.
