@@ -27,6 +27,24 @@ void WriteJson(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }
 
+void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                  const std::vector<std::string>& inputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [option, path] = outputs[i];
+    if (path.empty()) continue;
+    try {
+      CheckOutputPath(path, inputs);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(option + " " + error.what());
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (outputs[j].second == path) {
+        throw std::invalid_argument(option + " " + path + ": also given to " + outputs[j].first);
+      }
+    }
+  }
+}
+
 ScanRange ParseScanRange(const std::string& text, std::size_t count) {
   const auto colon = text.find(':');
   if (colon == std::string::npos) {

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cstddef>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -37,6 +39,11 @@ struct ScanRange {
   std::size_t end = 0;
 };
 ScanRange ParseScanRange(const std::string& text, std::size_t count);
+
+/// CheckOutputPath on every given output (option name, path; empty paths are skipped), and no two
+/// outputs the same file: throws std::invalid_argument naming the option, before any work.
+void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                  const std::vector<std::string>& inputs);
 
 /// --scans A:B as the scans [A, B) of the file that PrepareLogInputs keeps (clamped to the log
 /// there); nothing when `text` is empty.

@@ -64,6 +64,12 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
 
 void RunLocalize(const LocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  CheckOutputs({{"--json", options.json_path},
+                {"--queries", options.queries_path},
+                {"--curve", options.curve_path},
+                {"--reliability", options.reliability_path}},
+               {options.query.log_path, options.query.truth_path, options.query.index_path,
+                options.map_path});
   const bool baseline = !options.baseline.empty();
   if (!baseline && options.map_path.empty()) {
     throw std::invalid_argument("--map is required (except with --baseline tip-flirt)");

@@ -135,6 +135,11 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
 
 void RunMap(const MapOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  CheckOutputs({{"--out", options.out_path},
+                {"--json", options.json_path},
+                {"--png", options.png_path},
+                {"--svg", options.svg_path}},
+               {options.input});
   const Config config = ResolveConfig(options.config, [&](Config& c) {
     if (options.overlap_only) {
       c.mapping.use_distribution = false;

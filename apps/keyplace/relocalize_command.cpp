@@ -49,6 +49,12 @@ RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config&
 
 void RunRelocalize(const RelocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  CheckOutputs({{"--json", options.json_path},
+                {"--tsv", options.tsv_path},
+                {"--fixes", options.fixes_path},
+                {"--figure", options.figure_path}},
+               {options.query.log_path, options.query.truth_path, options.query.index_path,
+                options.map_path});
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);

@@ -62,6 +62,11 @@ void RunSlam(const SlamOptions& options) {
   if (options.truth_path.empty() != options.index_path.empty()) {
     throw std::invalid_argument("--truth and --index must be given together");
   }
+  CheckOutputs({{"--out", options.out_path},
+                {"--trajectory", options.trajectory_path},
+                {"--json", options.json_path},
+                {"--loops", options.loops_path}},
+               {options.input, options.truth_path, options.index_path, options.relations_path});
   const Config config = ResolveConfig(options.config);
   const ProcessingOrder order = ParseProcessingOrder(options.order);
   const LogInputs inputs = PrepareInputs(options.input, config);

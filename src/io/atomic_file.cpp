@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <system_error>
 
 namespace keyplace {
 
@@ -30,6 +31,28 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
     std::error_code ignored;
     fs::remove(temporary, ignored);
     throw;
+  }
+}
+
+void CheckOutputPath(const std::string& path, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path directory = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code error;
+  if (!fs::is_directory(directory, error)) {
+    throw std::invalid_argument(path + ": the directory " + directory.string() + " does not exist");
+  }
+  if (access(directory.c_str(), W_OK) != 0) {
+    throw std::invalid_argument(path + ": the directory " + directory.string() +
+                                " is not writable");
+  }
+  if (fs::is_directory(target, error)) throw std::invalid_argument(path + ": is a directory");
+  if (!fs::exists(target, error)) return;
+  for (const std::string& input : inputs) {
+    if (!input.empty() && fs::equivalent(target, fs::path(input), error)) {
+      throw std::invalid_argument(path + ": is the input " + input +
+                                  "; writing it would destroy the input");
+    }
   }
 }
 

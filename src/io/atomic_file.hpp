@@ -4,6 +4,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace keyplace {
 
@@ -11,5 +12,10 @@ namespace keyplace {
 /// On any failure (exception in `write`, I/O error) the temporary file is removed, `path` is left
 /// untouched and std::runtime_error names the path.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+/// Checks, before any work, that `path` can be written: its directory exists and is writable, it
+/// is not a directory, and it is none of `inputs` (the same file under any name, as an output
+/// would replace the input it is computed from). Throws std::invalid_argument naming the path.
+void CheckOutputPath(const std::string& path, const std::vector<std::string>& inputs);
 
 }  // namespace keyplace

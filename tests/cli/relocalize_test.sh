@@ -70,6 +70,18 @@ fails_with "bad config key" "localization.fix.nope" "$keyplace" relocalize --map
   --log "$log" --set localization.fix.nope=1
 fails_with "bad policy" "confirmations" "$keyplace" relocalize --map "$work/map.kpm" \
   --log "$log" --set localization.fix.confirmations=0
+# Outputs are checked before any work: not the input (a copy here, the bundled log must survive a
+# broken check), in a directory that exists, no two the same.
+cp "$log" "$work/copy.log.gz"
+fails_with "map --out is the input" "is the input" "$keyplace" map "$work/copy.log.gz" \
+  --out "$work/copy.log.gz"
+check "input intact" cmp "$log" "$work/copy.log.gz"
+fails_with "--json is the map" "--json" "$keyplace" relocalize --map "$work/map.kpm" \
+  --log "$log" --json "$work/map.kpm"
+fails_with "no such directory" "does not exist" "$keyplace" relocalize --map "$work/map.kpm" \
+  --log "$log" --tsv "$work/nowhere/s.tsv"
+fails_with "same output twice" "also given to --json" "$keyplace" relocalize \
+  --map "$work/map.kpm" --log "$log" --json "$work/x.json" --tsv "$work/x.json"
 echo '{"kept": true}' >"$work/keep.json"
 fails_with "bad map" "not.kpm" "$keyplace" relocalize --map "$work/not.kpm" --log "$log" \
   --json "$work/keep.json"
