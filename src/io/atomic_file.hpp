@@ -13,6 +13,15 @@ namespace keyplace {
 /// untouched and std::runtime_error names the path.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// The temporary file a write of `path` goes to first: `.NAME.tmpPID` beside it. Temporary files
+/// of `path` left by writers that no longer run (killed before their rename) are removed here.
+std::string TemporaryPathFor(const std::string& path);
+
+/// Makes `temporary` durable (fsync), renames it onto `path` and syncs the directory, so that after
+/// a power loss `path` holds either its old or its new content. Throws std::runtime_error naming
+/// `path`.
+void CommitTemporary(const std::string& temporary, const std::string& path);
+
 /// Checks, before any work, that `path` can be written: its directory exists and is writable, it
 /// is not a directory, and it is none of `inputs` (the same file under any name, as an output
 /// would replace the input it is computed from). Throws std::invalid_argument naming the path.

@@ -1,7 +1,6 @@
 #include "keyplace/store/map_file.hpp"
 
 #include <sqlite3.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <cstdint>
@@ -11,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "io/atomic_file.hpp"
 
 namespace keyplace {
 namespace {
@@ -271,23 +272,19 @@ void WriteAll(Database& db, const GlobalMap& map) {
 }  // namespace
 
 void SaveMap(const GlobalMap& map, const std::string& path) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path temporary =
-      target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()));
+  const std::string temporary = TemporaryPathFor(path);
   std::error_code ignored;
-  fs::remove(temporary, ignored);
+  std::filesystem::remove(temporary, ignored);
   try {
     {
-      Database db(temporary.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, path);
+      Database db(temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, path);
+      // No journal and no syncing while writing: the file is new, and CommitTemporary syncs it
+      // whole before the rename makes it the map.
       WriteAll(db, map);
     }
-    std::error_code error;
-    fs::rename(temporary, target, error);
-    if (error)
-      throw std::runtime_error(path + ": cannot rename temporary file: " + error.message());
+    CommitTemporary(temporary, path);
   } catch (...) {
-    fs::remove(temporary, ignored);
+    std::filesystem::remove(temporary, ignored);
     throw;
   }
 }
