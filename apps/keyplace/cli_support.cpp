@@ -39,7 +39,10 @@ void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& output
     }
     for (std::size_t j = 0; j < i; ++j) {
       if (outputs[j].second == path) {
-        throw std::invalid_argument(option + " " + path + ": also given to " + outputs[j].first);
+        std::string message = option;
+        message += " " + path;
+        message += ": also given to " + outputs[j].first;
+        throw std::invalid_argument(message);
       }
     }
   }

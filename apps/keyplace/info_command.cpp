@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "config_options.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/io/timestamps.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/store/map_file.hpp"
 
@@ -74,6 +75,11 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
     duration_s = log.scans.back().logger_timestamp_s - log.scans.front().logger_timestamp_s;
   }
   json["duration_s"] = duration_s;
+  std::vector<double> stamps;
+  for (const LogScan& scan : log.scans) stamps.push_back(scan.logger_timestamp_s);
+  const TimestampCheck stamp_check = CheckTimestamps(stamps);
+  json["timestamp_warnings"] = stamp_check.warnings;
+  json["timestamps_order_scans"] = stamp_check.CanOrder();
   json["path_length_m"] = PathLength(log);
   json["odometry_messages"] = log.odometry.size();
   json["graph_vertices"] = log.vertices.size();
@@ -100,6 +106,12 @@ void PrintLog(const nlohmann::json& json) {
   }
   fmt::print("field of view   {:.1f} deg\n", json["field_of_view_deg"].get<double>());
   fmt::print("duration        {:.1f} s\n", json["duration_s"].get<double>());
+  for (const auto& warning : json["timestamp_warnings"]) {
+    fmt::print("timestamps      warning: logger timestamps: {}\n", warning.get<std::string>());
+  }
+  if (!json["timestamps_order_scans"].get<bool>()) {
+    fmt::print("timestamps      cannot order the scans: slam and odometry need --order file\n");
+  }
   fmt::print("path length     {:.1f} m\n", json["path_length_m"].get<double>());
   fmt::print("no-return beams {}\n", json["no_return_beams"].get<std::size_t>());
   fmt::print("invalid beams   {} (NaN, infinite, zero or negative ranges)\n",

@@ -5,6 +5,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "keyplace/io/timestamps.hpp"
+
 namespace keyplace {
 
 ScanOrder ParseScanOrder(const std::string& text) {
@@ -79,6 +81,16 @@ OdometryRunStats SummarizeOdometryRun(const std::vector<ScanOdometryResult>& res
 OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometryConfig& config,
                             const OdometryRunOptions& options, const OdometryProgress& progress) {
   ValidateScanOdometryConfig(config);
+  if (options.order != ScanOrder::kFile) {
+    const bool logger = options.order == ScanOrder::kLogger;
+    std::vector<double> stamps;
+    stamps.reserve(scans.size());
+    for (const LogScan& scan : scans) {
+      stamps.push_back(logger ? scan.logger_timestamp_s : scan.timestamp_s);
+    }
+    RequireTimeOrder(CheckTimestamps(stamps),
+                     logger ? "the logger timestamps" : "the ipc timestamps");
+  }
   const std::vector<std::size_t> order = ProcessingOrder(scans, options.order);
   const std::size_t end = std::min(options.end, order.size());
   const std::size_t begin = std::min(options.begin, end);

@@ -5,6 +5,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "keyplace/io/timestamps.hpp"
+
 namespace keyplace {
 namespace {
 
@@ -127,6 +129,12 @@ SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, Processi
     throw std::invalid_argument("RunSlamOnLog: " + std::to_string(inputs.keypoints.size()) +
                                 " keypoint lists for the " + std::to_string(scans.size()) +
                                 " scans of " + inputs.log.path);
+  }
+  if (order == ProcessingOrder::kLogger) {
+    std::vector<double> stamps;
+    stamps.reserve(scans.size());
+    for (const LogScan& scan : scans) stamps.push_back(scan.logger_timestamp_s);
+    RequireTimeOrder(CheckTimestamps(stamps), inputs.log.path + ": the logger timestamps");
   }
   SlamRun run;
   run.slam = std::make_unique<OnlineSlam>(config);

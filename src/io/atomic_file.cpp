@@ -51,7 +51,9 @@ std::string TemporaryPathFor(const std::string& path) {
       fs::remove(it->path(), ignored);
     }
   }
-  return (target.parent_path() / (prefix + std::to_string(getpid()))).string();
+  std::string name = prefix;
+  name += std::to_string(getpid());
+  return (target.parent_path() / name).string();
 }
 
 void CommitTemporary(const std::string& temporary, const std::string& path) {

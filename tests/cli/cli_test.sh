@@ -52,6 +52,16 @@ c=j['config']
 assert c['odometry']['icp']['kernel'] == 'huber', c['odometry']
 assert float(c['evaluation']['local_relation_max_dt_s']) == 2, c['evaluation']" "$work/odo.json"
 check "odometry tsv rows" test "$(($(wc -l <"$work/odo.tsv") - 1))" = 100
+# Timestamps kept to 6 digits (rounded to 1000 s) cannot order the scans: info says so, odometry
+# by time refuses and points to --order file, which works.
+zcat "$log" | awk '$1 == "ROBOTLASER1" { if (++n > 60) exit; $NF = int($NF / 1000) * 1000 } { print }' \
+  >"$work/coarse.log"
+check "info on coarse stamps" "$keyplace" info "$work/coarse.log"
+cp "$work/out" "$work/coarse-info.txt"
+check "info warns" grep -q "cannot order the scans" "$work/coarse-info.txt"
+fails_with "odometry refuses coarse stamps" "--order file" "$keyplace" odometry "$work/coarse.log"
+check "odometry --order file" "$keyplace" odometry "$work/coarse.log" --order file
+
 fails_with "bad odometry --set value" "odometry.icp.kernel" "$keyplace" odometry "$log" \
   --set odometry.icp.kernel=gauss
 
