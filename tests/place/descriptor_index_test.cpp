@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -278,19 +279,22 @@ TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
       const SqrtDescriptorIndex built(places, kind);
       // Grown: the first 10 places at construction (one big tree), then one place at a time.
       SqrtDescriptorIndex grown(std::vector<Place>(places.begin(), places.begin() + 10), kind);
+      std::size_t most_trees = 0;
       for (std::size_t p = 10; p < places.size(); ++p) {
         ASSERT_EQ(grown.AddPlace(places[p].descriptors), p);
+        // The merging keeps the trees few.
+        ASSERT_LE(grown.trees(), std::log2(static_cast<double>(grown.keypoints())) + 1.0);
+        most_trees = std::max(most_trees, grown.trees());
       }
       ASSERT_EQ(grown.places(), places.size());
       ASSERT_EQ(grown.keypoints(), built.keypoints());
       if (kind == Index::kKdTree) {
-        // Added places get trees of their own (no rebuild), and the merging keeps them few.
+        // Added places get trees of their own (no rebuild of the whole index).
         EXPECT_EQ(built.trees(), 1u);
-        EXPECT_GT(grown.trees(), 1u);
-        EXPECT_LE(grown.trees(), std::log2(static_cast<double>(grown.keypoints())) + 1.0);
+        EXPECT_GT(most_trees, 2u);
       }
       for (double threshold : {0.1, 0.4, 0.8}) {
-        for (const SqrtDescriptorIndex* index : {&built, &grown}) {
+        for (const SqrtDescriptorIndex* index : {&built, &std::as_const(grown)}) {
           std::vector<std::vector<DescriptorPair>> below;
           index->FindPairs(query, threshold, searched, below);
           ASSERT_EQ(below.size(), places.size());
@@ -418,23 +422,25 @@ std::vector<PlaceMatch> Answers(const std::vector<LocalizationQuery>& queries,
   return answers;
 }
 
-void ExpectSameAnswers(const std::vector<LocalizationQuery>& queries,
-                       const PlaceRecognizer& incremental, const std::vector<Place>& places,
-                       const std::string& what) {
+std::vector<PlaceMatch> ExpectSameAnswers(const std::vector<LocalizationQuery>& queries,
+                                          const PlaceRecognizer& incremental,
+                                          const std::vector<Place>& places,
+                                          const std::string& what) {
   const PlaceRecognizer at_once(places, incremental.config());
-  ASSERT_EQ(incremental.places().size(), places.size()) << what;
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    ASSERT_EQ(incremental.places()[p].id, places[p].id) << what;
+  EXPECT_EQ(incremental.places().size(), places.size()) << what;
+  for (std::size_t p = 0; p < places.size() && p < incremental.places().size(); ++p) {
+    EXPECT_EQ(incremental.places()[p].id, places[p].id) << what;
   }
   const std::vector<PlaceMatch> expected = Answers(queries, at_once);
-  const std::vector<PlaceMatch> answers = Answers(queries, incremental);
-  ASSERT_EQ(answers.size(), expected.size());
+  std::vector<PlaceMatch> answers = Answers(queries, incremental);
+  EXPECT_EQ(answers.size(), expected.size());
   for (std::size_t i = 0; i < answers.size(); ++i) {
     const std::string where = what + ", start " + std::to_string(queries[i].start_scan);
     ExpectSameMatch(answers[i], expected[i], where);
     EXPECT_EQ(answers[i].place_index, expected[i].place_index) << where;
     EXPECT_EQ(answers[i].reference_coverage, expected[i].reference_coverage) << where;
   }
+  return answers;
 }
 
 TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog) {
@@ -445,9 +451,9 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
     const std::string name = kind == Index::kDense    ? "dense"
                              : kind == Index::kKdTree ? "kdtree"
                                                       : "none";
-    // Every 4th query (every 20th for the exhaustive search, which dominates this test's time).
+    // Every 20th query (every 100th for the exhaustive search, which dominates this test's time).
     std::vector<LocalizationQuery> queries;
-    for (std::size_t i = 0; i < b.queries.size(); i += kind == Index::kNone ? 20 : 4) {
+    for (std::size_t i = 0; i < b.queries.size(); i += kind == Index::kNone ? 100 : 20) {
       queries.push_back(b.queries[i]);
     }
     PlaceRecognitionConfig config;  // default preset
@@ -455,7 +461,8 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
 
     PlaceRecognizer incremental({}, config);
     for (const Place& place : all) incremental.AddPlace(place);
-    ExpectSameAnswers(queries, incremental, all, name + " added one by one");
+    const std::vector<PlaceMatch> before =
+        ExpectSameAnswers(queries, incremental, all, name + " added one by one");
 
     // Remove every 3rd place (a third of the keypoints: kept in the index, never searched).
     std::vector<Place> kept;
@@ -463,12 +470,10 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
     for (std::size_t p = 0; p < all.size(); ++p) (p % 3 == 1 ? removed : kept).push_back(all[p]);
     for (const Place& place : removed) ASSERT_TRUE(incremental.RemovePlace(place.id));
     EXPECT_FALSE(incremental.RemovePlace(removed.front().id));  // gone already
-    ExpectSameAnswers(queries, incremental, kept, name + " without every 3rd place");
+    const std::vector<PlaceMatch> after =
+        ExpectSameAnswers(queries, incremental, kept, name + " without every 3rd place");
     // Removed places never answer, though some answered before.
     int answered_by_removed = 0;
-    const PlaceRecognizer with_all(all, config);
-    const std::vector<PlaceMatch> before = Answers(queries, with_all);
-    const std::vector<PlaceMatch> after = Answers(queries, incremental);
     for (std::size_t i = 0; i < queries.size(); ++i) {
       for (const Place& place : removed) {
         if (before[i].verified && before[i].place_id == place.id) ++answered_by_removed;
@@ -478,7 +483,8 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
         }
       }
     }
-    EXPECT_GT(answered_by_removed, static_cast<int>(queries.size()) / 10) << name;
+    EXPECT_GT(answered_by_removed, 0) << name;
+    ASSERT_EQ(after.size(), queries.size());
 
     // Remove half of the rest (the removed keypoints now outnumber the live ones: the index is
     // rebuilt), then add the first removed places back, last in the list.
