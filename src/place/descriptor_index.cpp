@@ -49,13 +49,16 @@ void FillRoots(const BetaGridDescriptor& descriptor, double* row) {
   }
 }
 
-// nanoflann reads the rows of the root matrix through this adaptor (no copy).
+// nanoflann reads the rows [begin, begin + count) of the roots through this adaptor (no copy;
+// through the vector, which may reallocate as places are added).
 struct RootsAdaptor {
-  const RowMatrix* roots;
+  const std::vector<double>* roots;
+  std::size_t begin;
+  std::size_t count;
 
-  std::size_t kdtree_get_point_count() const { return static_cast<std::size_t>(roots->rows()); }
+  std::size_t kdtree_get_point_count() const { return count; }
   double kdtree_get_pt(std::size_t index, std::size_t dim) const {
-    return (*roots)(static_cast<Eigen::Index>(index), static_cast<Eigen::Index>(dim));
+    return (*roots)[(begin + index) * kBetaGridBins + dim];
   }
   template <class BoundingBox>
   bool kdtree_get_bbox(BoundingBox& /*bbox*/) const {
@@ -74,9 +77,9 @@ constexpr std::size_t kLeafSize = 16;
 
 struct SqrtDescriptorIndex::KdTree {
   RootsAdaptor adaptor;
-  RootsTree tree;
-  explicit KdTree(const RowMatrix& roots)
-      : adaptor{&roots},
+  RootsTree tree;  // built by its constructor
+  KdTree(const std::vector<double>& roots, std::size_t begin, std::size_t count)
+      : adaptor{&roots, begin, count},
         tree(kBetaGridBins, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {}
 };
 
@@ -86,26 +89,53 @@ SqrtDescriptorIndex::SqrtDescriptorIndex(const std::vector<Place>& places,
   if (kind == PlaceRecognitionConfig::DescriptorIndex::kNone) {
     throw std::invalid_argument("SqrtDescriptorIndex: descriptor_index none has no index");
   }
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    first_of_place_.push_back(static_cast<int>(descriptors_.size()));
-    for (const BetaGridDescriptor& descriptor : places[p].descriptors) {
-      descriptors_.push_back(descriptor);
-      place_of_.push_back(static_cast<int>(p));
-    }
-  }
-  first_of_place_.push_back(static_cast<int>(descriptors_.size()));
-  roots_.resize(static_cast<Eigen::Index>(descriptors_.size()), kBetaGridBins);
-  for (std::size_t k = 0; k < descriptors_.size(); ++k) {
-    FillRoots(descriptors_[k], roots_.row(static_cast<Eigen::Index>(k)).data());
-  }
-  squared_norms_ = roots_.rowwise().squaredNorm();
-  max_squared_norm_ = squared_norms_.size() > 0 ? squared_norms_.maxCoeff() : 0.0;
+  for (const Place& place : places) Append(place.descriptors);
+  // One tree over everything: a map loaded at once is searched as fast as before places could
+  // be added.
   if (kind == PlaceRecognitionConfig::DescriptorIndex::kKdTree && !descriptors_.empty()) {
-    tree_ = std::make_unique<KdTree>(roots_);
+    trees_.push_back(std::make_unique<KdTree>(roots_, 0, descriptors_.size()));
   }
 }
 
 SqrtDescriptorIndex::~SqrtDescriptorIndex() = default;
+
+void SqrtDescriptorIndex::Append(const std::vector<BetaGridDescriptor>& descriptors) {
+  const auto place = static_cast<int>(places());
+  for (const BetaGridDescriptor& descriptor : descriptors) {
+    const std::size_t row = roots_.size();
+    roots_.resize(row + kBetaGridBins);
+    FillRoots(descriptor, roots_.data() + row);
+    double squared_norm = 0.0;
+    for (int i = 0; i < kBetaGridBins; ++i) squared_norm += roots_[row + i] * roots_[row + i];
+    squared_norms_.push_back(squared_norm);
+    max_squared_norm_ = std::max(max_squared_norm_, squared_norm);
+    descriptors_.push_back(descriptor);
+    place_of_.push_back(place);
+  }
+  first_of_place_.push_back(static_cast<int>(descriptors_.size()));
+}
+
+std::size_t SqrtDescriptorIndex::AddPlace(const std::vector<BetaGridDescriptor>& descriptors) {
+  const std::size_t place = places();
+  const std::size_t begin = descriptors_.size();
+  Append(descriptors);
+  if (kind_ != PlaceRecognitionConfig::DescriptorIndex::kKdTree || descriptors.empty()) {
+    return place;
+  }
+  std::size_t count = descriptors.size();
+  // Merging trees at most twice the size of the new one keeps the sizes more than doubling from
+  // newest to oldest, hence few trees to search, and rebuilds each keypoint rarely.
+  std::size_t first = begin;
+  while (!trees_.empty() && trees_.back()->adaptor.count <= 2 * count) {
+    first = trees_.back()->adaptor.begin;
+    count += trees_.back()->adaptor.count;
+    trees_.pop_back();
+  }
+  trees_.push_back(std::make_unique<KdTree>(roots_, first, count));
+  return place;
+}
+
+std::size_t SqrtDescriptorIndex::trees() const { return trees_.size(); }
 
 double SqrtDescriptorIndex::SearchRadius2(double chi2_threshold, double query_squared_norm) const {
   return 2.0 * chi2_threshold * (1.0 + kRadiusSlack) +
@@ -142,12 +172,18 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
 
   if (kind_ == PlaceRecognitionConfig::DescriptorIndex::kKdTree) {
     std::vector<std::pair<std::size_t, double>> found;
+    std::vector<std::pair<std::size_t, double>> in_tree;
     for (std::size_t c = 0; c < query.size(); ++c) {
       const auto row = static_cast<Eigen::Index>(c);
+      const double radius2 = SearchRadius2(chi2_threshold, query_norms[row]);
       found.clear();
-      tree_->tree.radiusSearch(query_roots.row(row).data(),
-                               SearchRadius2(chi2_threshold, query_norms[row]), found,
-                               nanoflann::SearchParams(32, 0.0f, false));
+      for (const auto& tree : trees_) {
+        tree->tree.radiusSearch(query_roots.row(row).data(), radius2, in_tree,
+                                nanoflann::SearchParams(32, 0.0f, false));
+        for (const auto& [local, distance2] : in_tree) {
+          found.emplace_back(tree->adaptor.begin + local, distance2);
+        }
+      }
       std::sort(found.begin(), found.end());  // by keypoint: the exhaustive order
       for (const auto& [keypoint, distance2] : found) {
         if (searched[static_cast<std::size_t>(place_of_[keypoint])]) {
@@ -160,14 +196,16 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
 
   // kDense: ||u - v||^2 = ||u||^2 + ||v||^2 - 2 u.v for a block of query rows against every
   // keypoint at once (one matrix product), then the exact test where it is within the radius.
-  const auto n_keypoints = static_cast<std::size_t>(roots_.rows());
+  const std::size_t n_keypoints = descriptors_.size();
+  const Eigen::Map<const RowMatrix> roots(roots_.data(), static_cast<Eigen::Index>(n_keypoints),
+                                          kBetaGridBins);
   const std::size_t block = std::clamp<std::size_t>(kProductBudget / n_keypoints, 1, 64);
   Eigen::MatrixXd dots;  // keypoint x query row of the block, column-major
   for (std::size_t begin = 0; begin < query.size(); begin += block) {
     const std::size_t rows = std::min(block, query.size() - begin);
     dots.resize(static_cast<Eigen::Index>(n_keypoints), static_cast<Eigen::Index>(rows));
     dots.noalias() =
-        roots_ *
+        roots *
         query_roots.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(rows))
             .transpose();
     for (std::size_t j = 0; j < rows; ++j) {
@@ -179,8 +217,7 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
         if (!searched[p]) continue;
         const auto end = static_cast<std::size_t>(first_of_place_[p + 1]);
         for (auto k = static_cast<std::size_t>(first_of_place_[p]); k < end; ++k) {
-          if (squared_norms_[static_cast<Eigen::Index>(k)] + query_norm - 2.0 * column[k] <
-              radius2) {
+          if (squared_norms_[k] + query_norm - 2.0 * column[k] < radius2) {
             AddIfBelow(query[c], static_cast<int>(c), k, chi2_threshold, below);
           }
         }

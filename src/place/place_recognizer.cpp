@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 
 #include "keyplace/place/ransac.hpp"
@@ -292,9 +294,51 @@ PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecogniti
                                   ": positions and descriptors differ in size");
     }
   }
-  if (config_.descriptor_index != PlaceRecognitionConfig::DescriptorIndex::kNone) {
-    index_ = std::make_shared<const SqrtDescriptorIndex>(places_, config_.descriptor_index);
+  RebuildIndex();
+}
+
+PlaceRecognizer::~PlaceRecognizer() = default;
+
+void PlaceRecognizer::RebuildIndex() {
+  index_.reset();
+  slots_.clear();
+  removed_keypoints_ = 0;
+  if (config_.descriptor_index == PlaceRecognitionConfig::DescriptorIndex::kNone) return;
+  index_ = std::make_shared<SqrtDescriptorIndex>(places_, config_.descriptor_index);
+  for (std::size_t p = 0; p < places_.size(); ++p) slots_.push_back(p);
+}
+
+void PlaceRecognizer::AddPlace(Place place) {
+  if (place.positions.size() != place.descriptors.size()) {
+    throw std::invalid_argument("Place " + std::to_string(place.id) +
+                                ": positions and descriptors differ in size");
   }
+  places_.push_back(std::move(place));
+  if (!index_) return;  // kNone
+  if (index_.use_count() > 1) {
+    RebuildIndex();  // a copy shares the index: never change it under the copy
+    return;
+  }
+  slots_.push_back(index_->AddPlace(places_.back().descriptors));
+}
+
+bool PlaceRecognizer::RemovePlace(int place_id) {
+  const auto it = std::find_if(places_.begin(), places_.end(),
+                               [place_id](const Place& place) { return place.id == place_id; });
+  if (it == places_.end()) return false;
+  const auto p = static_cast<std::size_t>(it - places_.begin());
+  removed_keypoints_ += it->descriptors.size();
+  places_.erase(it);
+  if (!index_) return true;  // kNone
+  slots_.erase(slots_.begin() + static_cast<std::ptrdiff_t>(p));
+  // The removed keypoints stay indexed (never searched: Recognize searches the slots of places_)
+  // until they are the majority, so rebuilding costs O(1) amortised per removed keypoint.
+  if (index_.use_count() > 1 || 2 * removed_keypoints_ > index_->keypoints()) RebuildIndex();
+  return true;
+}
+
+void PlaceRecognizer::SetPlacePose(std::size_t place_index, const Pose2& T_world_place) {
+  places_.at(place_index).T_world_place = T_world_place;
 }
 
 PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
@@ -347,15 +391,17 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     }
     // The index finds, per place, the pairs below the threshold that the exhaustive loop of
     // MatchDescriptorPairs finds, in its order and with its distances.
-    std::vector<std::vector<DescriptorPair>> below;
+    std::vector<std::vector<DescriptorPair>> below;  // by index slot
     if (index_) {
-      index_->FindPairs(*match_descriptors, config_.descriptor_match_chi2, searched, below);
+      std::vector<char> searched_slots(index_->places(), 0);
+      for (std::size_t p = 0; p < places_.size(); ++p) searched_slots[slots_[p]] = searched[p];
+      index_->FindPairs(*match_descriptors, config_.descriptor_match_chi2, searched_slots, below);
     }
     for (std::size_t p = 0; p < places_.size(); ++p) {
       if (!searched[p]) continue;
       const Place& place = places_[p];
       std::vector<DescriptorPair> pairs =
-          index_ ? UniquePairs(std::move(below[p]), match_descriptors->size(),
+          index_ ? UniquePairs(std::move(below[slots_[p]]), match_descriptors->size(),
                                place.descriptors.size(), config_.pair_matching)
                  : MatchDescriptorPairs(*match_descriptors, place.descriptors,
                                         config_.descriptor_match_chi2, config_.pair_matching);

@@ -170,10 +170,17 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
     ++eligible;
   }
   if (eligible > 0) {
-    if (!recognizer_ || recognizer_places_ != eligible) {
-      recognizer_ = std::make_unique<PlaceRecognizer>(
-          std::vector<Place>(places_.begin(), places_.begin() + eligible), config_.place);
-      recognizer_places_ = eligible;
+    if (!recognizer_)
+      recognizer_ = std::make_unique<PlaceRecognizer>(std::vector<Place>{}, config_.place);
+    if (recognizer_->places().size() != eligible) {
+      // The recognizer holds the eligible prefix; it only grows (eligibility depends on the id and
+      // the path, both growing), so each submap is indexed once. Held places take the graph poses
+      // of now, as a recognizer built anew from the prefix would (a pose changes no descriptor).
+      const std::size_t held = recognizer_->places().size();
+      for (std::size_t i = 0; i < held; ++i) {
+        recognizer_->SetPlacePose(i, places_[i].T_world_place);
+      }
+      for (std::size_t i = held; i < eligible; ++i) recognizer_->AddPlace(places_[i]);
     }
     ++stats_.queries;
     step.match = recognizer_->Recognize(query);

@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -275,27 +276,45 @@ TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
     std::vector<char> searched(places.size(), 1);
     for (std::size_t p = 0; p < places.size(); p += 7) searched[p] = 0;
     for (Index kind : {Index::kDense, Index::kKdTree}) {
-      const SqrtDescriptorIndex index(places, kind);
+      const SqrtDescriptorIndex built(places, kind);
+      // Grown: the first 10 places at construction (one big tree), then one place at a time.
+      SqrtDescriptorIndex grown(std::vector<Place>(places.begin(), places.begin() + 10), kind);
+      std::size_t most_trees = 0;
+      for (std::size_t p = 10; p < places.size(); ++p) {
+        ASSERT_EQ(grown.AddPlace(places[p].descriptors), p);
+        // The merging keeps the trees few.
+        ASSERT_LE(grown.trees(), std::log2(static_cast<double>(grown.keypoints())) + 1.0);
+        most_trees = std::max(most_trees, grown.trees());
+      }
+      ASSERT_EQ(grown.places(), places.size());
+      ASSERT_EQ(grown.keypoints(), built.keypoints());
+      if (kind == Index::kKdTree) {
+        // Added places get trees of their own (no rebuild of the whole index).
+        EXPECT_EQ(built.trees(), 1u);
+        EXPECT_GT(most_trees, 2u);
+      }
       for (double threshold : {0.1, 0.4, 0.8}) {
-        std::vector<std::vector<DescriptorPair>> below;
-        index.FindPairs(query, threshold, searched, below);
-        ASSERT_EQ(below.size(), places.size());
-        for (std::size_t p = 0; p < places.size(); ++p) {
-          const std::vector<DescriptorPair> expected =
-              searched[p] ? ExhaustiveBelow(query, places[p].descriptors, threshold)
-                          : std::vector<DescriptorPair>{};
-          ASSERT_EQ(below[p].size(), expected.size()) << "place " << p;
-          for (std::size_t k = 0; k < expected.size(); ++k) {
-            EXPECT_EQ(below[p][k].current, expected[k].current);
-            EXPECT_EQ(below[p][k].reference, expected[k].reference);
-            EXPECT_EQ(below[p][k].distance, expected[k].distance);  // bit for bit
+        for (const SqrtDescriptorIndex* index : {&built, &std::as_const(grown)}) {
+          std::vector<std::vector<DescriptorPair>> below;
+          index->FindPairs(query, threshold, searched, below);
+          ASSERT_EQ(below.size(), places.size());
+          for (std::size_t p = 0; p < places.size(); ++p) {
+            const std::vector<DescriptorPair> expected =
+                searched[p] ? ExhaustiveBelow(query, places[p].descriptors, threshold)
+                            : std::vector<DescriptorPair>{};
+            ASSERT_EQ(below[p].size(), expected.size()) << "place " << p;
+            for (std::size_t k = 0; k < expected.size(); ++k) {
+              EXPECT_EQ(below[p][k].current, expected[k].current);
+              EXPECT_EQ(below[p][k].reference, expected[k].reference);
+              EXPECT_EQ(below[p][k].distance, expected[k].distance);  // bit for bit
+            }
+            pairs_seen += expected.size();
           }
-          pairs_seen += expected.size();
         }
       }
     }
   }
-  EXPECT_GT(pairs_seen, 10000u);  // the sets do have pairs near every threshold
+  EXPECT_GT(pairs_seen, 20000u);  // the sets do have pairs near every threshold
 }
 
 TEST(DescriptorIndex, NoneHasNoIndexAndEmptyMapsWork) {
@@ -388,6 +407,123 @@ TEST(DescriptorIndex, SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog) {
     }
   }
   EXPECT_GT(found, static_cast<int>(b.queries.size()) * 9 / 10);  // recall ~0.98
+}
+
+// Incremental place database: a recognizer grown place by place (from empty), then shrunk and
+// grown again, gives on the bundled log the answers of a recognizer built at once from the same
+// places, for every descriptor index; removed places never answer.
+std::vector<PlaceMatch> Answers(const std::vector<LocalizationQuery>& queries,
+                                const PlaceRecognizer& recognizer) {
+  std::vector<PlaceMatch> answers;
+  for (const LocalizationRecord& record :
+       EvaluateQueries(queries, recognizer, SelfMatchRule::kSameScans)) {
+    answers.push_back(record.match);
+  }
+  return answers;
+}
+
+std::vector<PlaceMatch> ExpectSameAnswers(const std::vector<LocalizationQuery>& queries,
+                                          const PlaceRecognizer& incremental,
+                                          const std::vector<Place>& places,
+                                          const std::string& what) {
+  const PlaceRecognizer at_once(places, incremental.config());
+  EXPECT_EQ(incremental.places().size(), places.size()) << what;
+  for (std::size_t p = 0; p < places.size() && p < incremental.places().size(); ++p) {
+    EXPECT_EQ(incremental.places()[p].id, places[p].id) << what;
+  }
+  const std::vector<PlaceMatch> expected = Answers(queries, at_once);
+  std::vector<PlaceMatch> answers = Answers(queries, incremental);
+  EXPECT_EQ(answers.size(), expected.size());
+  for (std::size_t i = 0; i < answers.size(); ++i) {
+    const std::string where = what + ", start " + std::to_string(queries[i].start_scan);
+    ExpectSameMatch(answers[i], expected[i], where);
+    EXPECT_EQ(answers[i].place_index, expected[i].place_index) << where;
+    EXPECT_EQ(answers[i].reference_coverage, expected[i].reference_coverage) << where;
+  }
+  return answers;
+}
+
+TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog) {
+  const Bundled& b = BundledLog();
+  const std::vector<Place> all = PlacesFromMap(b.map);
+  ASSERT_GT(all.size(), 30u);
+  for (Index kind : {Index::kDense, Index::kKdTree, Index::kNone}) {
+    const std::string name = kind == Index::kDense    ? "dense"
+                             : kind == Index::kKdTree ? "kdtree"
+                                                      : "none";
+    // Every 20th query (every 100th for the exhaustive search, which dominates this test's time).
+    std::vector<LocalizationQuery> queries;
+    for (std::size_t i = 0; i < b.queries.size(); i += kind == Index::kNone ? 100 : 20) {
+      queries.push_back(b.queries[i]);
+    }
+    PlaceRecognitionConfig config;  // default preset
+    config.descriptor_index = kind;
+
+    PlaceRecognizer incremental({}, config);
+    for (const Place& place : all) incremental.AddPlace(place);
+    const std::vector<PlaceMatch> before =
+        ExpectSameAnswers(queries, incremental, all, name + " added one by one");
+
+    // Remove every 3rd place (a third of the keypoints: kept in the index, never searched).
+    std::vector<Place> kept;
+    std::vector<Place> removed;
+    for (std::size_t p = 0; p < all.size(); ++p) (p % 3 == 1 ? removed : kept).push_back(all[p]);
+    for (const Place& place : removed) ASSERT_TRUE(incremental.RemovePlace(place.id));
+    EXPECT_FALSE(incremental.RemovePlace(removed.front().id));  // gone already
+    const std::vector<PlaceMatch> after =
+        ExpectSameAnswers(queries, incremental, kept, name + " without every 3rd place");
+    // Removed places never answer, though some answered before.
+    int answered_by_removed = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      for (const Place& place : removed) {
+        if (before[i].verified && before[i].place_id == place.id) ++answered_by_removed;
+        EXPECT_NE(after[i].place_id, place.id);
+        for (const CandidateResult& candidate : after[i].verified_candidates) {
+          EXPECT_NE(incremental.places()[candidate.place_index].id, place.id);
+        }
+      }
+    }
+    EXPECT_GT(answered_by_removed, 0) << name;
+    ASSERT_EQ(after.size(), queries.size());
+
+    // Remove half of the rest (the removed keypoints now outnumber the live ones: the index is
+    // rebuilt), then add the first removed places back, last in the list.
+    std::vector<Place> rest;
+    for (std::size_t p = 0; p < kept.size(); ++p) {
+      if (p % 2 == 0) {
+        rest.push_back(kept[p]);
+      } else {
+        ASSERT_TRUE(incremental.RemovePlace(kept[p].id));
+      }
+    }
+    for (const Place& place : removed) {
+      incremental.AddPlace(place);
+      rest.push_back(place);
+    }
+    ExpectSameAnswers(queries, incremental, rest, name + " after removals and additions");
+  }
+}
+
+TEST(PlaceDatabase, CopiesDoNotShareChangesAndBadInputThrows) {
+  const Bundled& b = BundledLog();
+  const std::vector<Place> all = PlacesFromMap(b.map);
+  PlaceRecognitionConfig config;
+  const PlaceRecognizer original(std::vector<Place>(all.begin(), all.end() - 5), config);
+  PlaceRecognizer copy = original;
+  for (auto it = all.end() - 5; it != all.end(); ++it) copy.AddPlace(*it);
+  ASSERT_TRUE(copy.RemovePlace(all.front().id));
+  EXPECT_EQ(original.places().size(), all.size() - 5);
+  std::vector<LocalizationQuery> queries;
+  for (std::size_t i = 0; i < b.queries.size(); i += 10) queries.push_back(b.queries[i]);
+  ExpectSameAnswers(queries, original, std::vector<Place>(all.begin(), all.end() - 5), "original");
+  ExpectSameAnswers(queries, copy, std::vector<Place>(all.begin() + 1, all.end()), "copy");
+
+  Place bad = all.front();
+  bad.positions.pop_back();
+  EXPECT_THROW(copy.AddPlace(bad), std::invalid_argument);
+  EXPECT_THROW(copy.SetPlacePose(copy.places().size(), Pose2{}), std::out_of_range);
+  copy.SetPlacePose(0, Pose2{1.0, 2.0, 0.5});
+  EXPECT_EQ(copy.places()[0].T_world_place.x, 1.0);
 }
 
 }  // namespace

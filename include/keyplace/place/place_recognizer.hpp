@@ -6,6 +6,7 @@
 // Descriptor pairs come from an exact index over all place keypoints (descriptor_index), or from
 // exhaustive matching (descriptor_index none): the oracle, with the same pairs.
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <utility>
@@ -142,16 +143,41 @@ class PlaceRecognizer {
  public:
   /// Throws std::invalid_argument (Validate) for an invalid config.
   PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config);
+  // Copies share the index until one of them adds or removes a place (it then indexes its own).
+  PlaceRecognizer(const PlaceRecognizer&) = default;
+  PlaceRecognizer& operator=(const PlaceRecognizer&) = default;
+  PlaceRecognizer(PlaceRecognizer&&) = default;
+  PlaceRecognizer& operator=(PlaceRecognizer&&) = default;
+  ~PlaceRecognizer();
 
+  /// Appends a place (last in places()) and indexes its descriptors without rebuilding the index:
+  /// every answer is then the one of a recognizer constructed from places() at once. Throws
+  /// std::invalid_argument when its positions and descriptors differ in size.
+  void AddPlace(Place place);
+  /// Removes the first place with this id (later places move up one index); every answer is then
+  /// the one of a recognizer constructed from the remaining places() at once. The index forgets
+  /// the place's keypoints lazily (a rebuild from places() once the removed keypoints outnumber
+  /// the live ones). Returns false, and changes nothing, when no place has the id.
+  bool RemovePlace(int place_id);
+  /// Sets the world pose of places()[place_index] (no index change: descriptors do not move).
+  /// Throws std::out_of_range for an index outside places().
+  void SetPlacePose(std::size_t place_index, const Pose2& T_world_place);
+
+  /// Not thread-safe with AddPlace, RemovePlace or SetPlacePose on the same recognizer.
   PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
 
   const std::vector<Place>& places() const { return places_; }
   const PlaceRecognitionConfig& config() const { return config_; }
 
  private:
+  // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for kNone.
+  void RebuildIndex();
+
   std::vector<Place> places_;
   PlaceRecognitionConfig config_;
-  std::shared_ptr<const SqrtDescriptorIndex> index_;  // null for descriptor_index none
+  std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none
+  std::vector<std::size_t> slots_;              // index place number of each of places_
+  std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
 };
 
 }  // namespace keyplace

@@ -199,8 +199,7 @@ class OnlineSlam {
   // Endpoints (robot frame, range-filtered) of the scans of the submap in progress.
   std::vector<std::vector<Eigen::Vector2d>> pending_points_;
   std::vector<Place> places_;  // one per completed submap (place frame = submap frame)
-  std::unique_ptr<PlaceRecognizer> recognizer_;
-  std::size_t recognizer_places_ = 0;  // prefix of places_ the recognizer holds
+  std::unique_ptr<PlaceRecognizer> recognizer_;  // the eligible prefix of places_
   std::vector<LoopClosure> loops_;
   int loops_since_optimization_ = 0;
   bool dirty_ = false;  // loops added since the last optimisation
