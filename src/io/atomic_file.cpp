@@ -99,8 +99,10 @@ void CheckOutputPath(const std::string& path, const std::vector<std::string>& in
   if (!fs::exists(target, error)) return;
   for (const std::string& input : inputs) {
     if (!input.empty() && fs::equivalent(target, fs::path(input), error)) {
-      throw std::invalid_argument(path + ": is the input " + input +
-                                  "; writing it would destroy the input");
+      std::string message = path;
+      message += ": is the input " + input;
+      message += "; writing it would destroy the input";
+      throw std::invalid_argument(message);
     }
   }
 }
