@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
@@ -64,6 +65,8 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
 
 void RunLocalize(const LocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                    WorkerThreads(options.query.threads));
   const bool baseline = !options.baseline.empty();
   if (!baseline && options.map_path.empty()) {
     throw std::invalid_argument("--map is required (except with --baseline tip-flirt)");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
@@ -49,6 +50,8 @@ RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config&
 
 void RunRelocalize(const RelocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                    WorkerThreads(options.query.threads));
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);
