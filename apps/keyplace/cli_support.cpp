@@ -9,10 +9,20 @@
 #include <stdexcept>
 
 #include <fmt/core.h>
+#include <tbb/task_arena.h>
 
 #include "io/atomic_file.hpp"
 
 namespace keyplace::cli {
+
+std::size_t WorkerThreads(int threads) {
+  if (threads < 0) {
+    throw std::invalid_argument("--threads " + std::to_string(threads) +
+                                ": expected 0 (all cores) or more");
+  }
+  return threads > 0 ? static_cast<std::size_t>(threads)
+                     : static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+}
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

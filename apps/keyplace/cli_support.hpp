@@ -27,6 +27,10 @@ inline constexpr const char* kSkipBadLinesHelp =
 /// stderr, one "keyplace: warning: ..." line each.
 void PrintLogWarnings(const CarmenLog& log);
 
+/// The worker threads of --threads N (tbb::global_control's max_allowed_parallelism): N, or every
+/// core when N is 0. Throws std::invalid_argument for N < 0.
+std::size_t WorkerThreads(int threads);
+
 /// Seconds since `start` (steady clock).
 double SecondsSince(std::chrono::steady_clock::time_point start);
 

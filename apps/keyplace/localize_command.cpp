@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
@@ -70,6 +71,8 @@ void RunLocalize(const LocalizeOptions& options) {
                 {"--reliability", options.reliability_path}},
                {options.query.log_path, options.query.truth_path, options.query.index_path,
                 options.map_path});
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                    WorkerThreads(options.query.threads));
   const bool baseline = !options.baseline.empty();
   if (!baseline && options.map_path.empty()) {
     throw std::invalid_argument("--map is required (except with --baseline tip-flirt)");

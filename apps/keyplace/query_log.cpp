@@ -24,6 +24,11 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
                       "Query scans A:B of the log (a time split: the map of --scans 0:A, the "
                       "queries from A:)");
   command->add_flag("--skip-bad-lines", options.skip_bad_lines, kSkipBadLinesHelp);
+  command
+      ->add_option("--threads", options.threads,
+                   "Worker threads (0 = all cores); the figures do not depend on it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {

@@ -1,6 +1,7 @@
 #pragma once
 // The query log of the localization commands (localize, relocalize): its options (--log, --poses,
-// --truth, --index, --scans, --skip-bad-lines) and reading it with its ground truth.
+// --truth, --index, --scans, --skip-bad-lines, and --threads for the work on it) and reading it
+// with its ground truth.
 
 #include <string>
 
@@ -19,6 +20,7 @@ struct QueryLogOptions {
   std::string index_path;
   std::string scans;
   bool skip_bad_lines = false;
+  int threads = 0;  // worker threads for keypoints and queries (WorkerThreads: 0 = all cores)
 };
 
 /// Registers the options; `poses_help` says what the poses are used for.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
@@ -55,6 +56,8 @@ void RunRelocalize(const RelocalizeOptions& options) {
                 {"--figure", options.figure_path}},
                {options.query.log_path, options.query.truth_path, options.query.index_path,
                 options.map_path});
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                    WorkerThreads(options.query.threads));
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);

@@ -10,7 +10,6 @@
 
 #include <fmt/core.h>
 #include <tbb/global_control.h>
-#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
@@ -111,8 +110,7 @@ void RunSweepMapping(const SweepOptions& options) {
   const Config config = ResolveSweepConfig(options);
   for (const auto& point : grid) MappingConfigAt(config.mapping, point[0], point[1]);
   tbb::global_control control(tbb::global_control::max_allowed_parallelism,
-                              options.threads > 0 ? static_cast<std::size_t>(options.threads)
-                                                  : tbb::this_task_arena::max_concurrency());
+                              WorkerThreads(options.threads));
   const LogInputs inputs = PrepareInputs(options, config, false);
   nlohmann::json identity = Identity("mapping", options, inputs, config);
   identity["overlap_only"] = options.overlap_only;
@@ -156,8 +154,7 @@ void RunSweepPlace(const SweepOptions& options) {
   const SelfMatchRule rule =
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
   tbb::global_control control(tbb::global_control::max_allowed_parallelism,
-                              options.threads > 0 ? static_cast<std::size_t>(options.threads)
-                                                  : tbb::this_task_arena::max_concurrency());
+                              WorkerThreads(options.threads));
   const LogInputs inputs = PrepareInputs(options, config, true);
   const std::vector<std::string> parameters{"s_min", "l_g", "mu", "gamma_min", "lambda"};
   const std::vector<std::string> values{

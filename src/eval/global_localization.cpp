@@ -1,10 +1,15 @@
 #include "keyplace/eval/global_localization.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "eval/parallel_progress.hpp"
 #include "keyplace/localization/query_builder.hpp"
 
 namespace keyplace {
@@ -33,6 +38,24 @@ void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth, Local
   query.truth = truth.Pose(static_cast<std::size_t>(query.evaluated_scan));
 }
 
+// One query of EvaluateQueries.
+LocalizationRecord Evaluate(const LocalizationQuery& query, const PlaceRecognizer& recognizer,
+                            SelfMatchRule rule) {
+  LocalizationRecord record;
+  record.start_scan = query.start_scan;
+  record.evaluated_scan = query.evaluated_scan;
+  record.scans = query.scans;
+  record.truth = query.truth;
+  record.build_seconds = query.build_seconds;
+  record.match = recognizer.Recognize(query.query, [&](const Place& place) {
+    return IsSelfMatch(rule, query.truth_scans, place.scan_indices);
+  });
+  record.verified_correct =
+      record.match.verified && IsCorrectPose(record.match.estimated_pose, record.truth);
+  record.correct = record.match.found && record.verified_correct;
+  return record;
+}
+
 }  // namespace
 
 std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos) {
@@ -55,27 +78,41 @@ std::vector<LocalizationQuery> BuildSubmapQueries(
     const std::vector<int>& starts, PlaceRecognitionConfig::QueryKeypoints query_keypoints,
     const QueryProgress& progress) {
   const std::vector<LogScan>& scans = inputs.log.scans;
-  SubmapQueryBuilder builder(mapping);
-  std::vector<LocalizationQuery> queries;
-  for (std::size_t i = 0; i < starts.size(); ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    builder.Reset();
-    bool complete = false;
-    for (auto k = static_cast<std::size_t>(starts[i]); k < scans.size() && !complete; ++k) {
-      complete =
-          builder.AddScan(scans[k], inputs.poses[k], inputs.keypoints[k], static_cast<int>(k));
-    }
-    if (!complete) break;  // Algorithm 4: the log ends before the submap is complete
-    LocalizationQuery query;
-    query.start_scan = starts[i];
-    query.scans = static_cast<int>(builder.size());
-    std::size_t evaluated_position = 0;  // the start scan has a truth pose
-    SetTruth(builder, truth, query, evaluated_position);
-    query.query = builder.Query(evaluated_position, query_keypoints);
-    query.build_seconds = SecondsSince(start);
-    queries.push_back(std::move(query));
-    if (progress) progress(i + 1, starts.size());
-  }
+  std::vector<LocalizationQuery> queries(starts.size());
+  // Algorithm 4 stops at the first start whose submap the log ends before completing: the
+  // smallest such index. Once one is known, later starts are skipped; all are dropped at the end.
+  std::atomic<std::size_t> first_incomplete{starts.size()};
+  ParallelProgress done(progress, starts.size());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, starts.size()),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        SubmapQueryBuilder builder(mapping);  // reset for every query: none depends on another
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          if (i > first_incomplete.load()) return;  // so are the rest of the range
+          const auto start = std::chrono::steady_clock::now();
+          builder.Reset();
+          bool complete = false;
+          for (auto k = static_cast<std::size_t>(starts[i]); k < scans.size() && !complete; ++k) {
+            complete = builder.AddScan(scans[k], inputs.poses[k], inputs.keypoints[k],
+                                       static_cast<int>(k));
+          }
+          if (!complete) {
+            std::size_t known = first_incomplete.load();
+            while (i < known && !first_incomplete.compare_exchange_weak(known, i)) {
+            }
+            return;
+          }
+          LocalizationQuery& query = queries[i];
+          query.start_scan = starts[i];
+          query.scans = static_cast<int>(builder.size());
+          std::size_t evaluated_position = 0;  // the start scan has a truth pose
+          SetTruth(builder, truth, query, evaluated_position);
+          query.query = builder.Query(evaluated_position, query_keypoints);
+          query.build_seconds = SecondsSince(start);
+          done.ItemDone();
+        }
+      });
+  queries.resize(first_incomplete.load());
   return queries;
 }
 
@@ -138,25 +175,15 @@ double RankScore(RankBy rank_by, const PlaceMatch& match) {
 std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQuery>& queries,
                                                 const PlaceRecognizer& recognizer,
                                                 SelfMatchRule rule, const QueryProgress& progress) {
-  std::vector<LocalizationRecord> records;
-  records.reserve(queries.size());
-  for (std::size_t i = 0; i < queries.size(); ++i) {
-    const LocalizationQuery& query = queries[i];
-    LocalizationRecord record;
-    record.start_scan = query.start_scan;
-    record.evaluated_scan = query.evaluated_scan;
-    record.scans = query.scans;
-    record.truth = query.truth;
-    record.build_seconds = query.build_seconds;
-    record.match = recognizer.Recognize(query.query, [&](const Place& place) {
-      return IsSelfMatch(rule, query.truth_scans, place.scan_indices);
-    });
-    record.verified_correct =
-        record.match.verified && IsCorrectPose(record.match.estimated_pose, record.truth);
-    record.correct = record.match.found && record.verified_correct;
-    records.push_back(std::move(record));
-    if (progress) progress(i + 1, queries.size());
-  }
+  std::vector<LocalizationRecord> records(queries.size());
+  ParallelProgress done(progress, queries.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size()),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        records[i] = Evaluate(queries[i], recognizer, rule);
+                        done.ItemDone();
+                      }
+                    });
   return records;
 }
 

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <optional>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "eval/parallel_progress.hpp"
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/localization.hpp"
 #include "keyplace/localization/relocalizer.hpp"
@@ -213,20 +217,27 @@ std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs
                                            const GroundTruth& truth, const LocalizerConfig& config,
                                            const RelocalizationOptions& options,
                                            const StartProgress& progress) {
-  Relocalizer relocalizer(map, config);
+  Relocalizer prototype(map, config);
   if (options.exclude_shared_scans) {
-    relocalizer.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
+    prototype.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
       return IsSelfMatch(SelfMatchRule::kSharedScan, query_scans, place.scan_indices);
     });
   }
   const RevisitChecker revisits(map, options);
   const std::vector<int> starts = QueryStarts(truth, options.starts);
-  std::vector<StartRecord> records;
-  for (const int start : starts) {
-    StartRun run(relocalizer, inputs, truth, revisits, options);
-    records.push_back(run.Run(start));
-    if (progress) progress(records.size(), starts.size());
-  }
+  std::vector<StartRecord> records(starts.size());
+  ParallelProgress done(progress, starts.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, starts.size()),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      // A copy shares the prototype's recognizer (read-only) and has its own
+                      // query and fix; every start resets them.
+                      Relocalizer relocalizer = prototype;
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        StartRun run(relocalizer, inputs, truth, revisits, options);
+                        records[i] = run.Run(starts[i]);
+                        done.ItemDone();
+                      }
+                    });
   return records;
 }
 

@@ -76,7 +76,12 @@ check "map png" test -s "$work/map.png"
 check "info on map" "$keyplace" info "$work/map.kpm" --json "$work/mapinfo.json"
 check "info map submaps" test "$(json_value "$work/mapinfo.json" submaps)" = "$(json_value "$work/map.json" submaps)"
 check "localize" "$keyplace" localize --map "$work/map.kpm" --log "$log" --n-pos 40 \
-  --json "$work/loc.json" --queries "$work/loc.tsv"
+  --threads 2 --json "$work/loc.json" --queries "$work/loc.tsv"
+# The queries run in parallel: one thread gives the same figures and rows, times aside.
+check "localize, 1 thread" "$keyplace" localize --map "$work/map.kpm" --log "$log" --n-pos 40 \
+  --threads 1 --json "$work/loc1.json" --queries "$work/loc1.tsv"
+check "localize: same JSON at 1 and 2 threads" same_figures "$work/loc1.json" "$work/loc.json"
+check "localize: same rows at 1 and 2 threads" same_figures "$work/loc1.tsv" "$work/loc.tsv"
 check "localize json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))

@@ -13,7 +13,12 @@ log="$source_dir/data/fr079-corrected.log.gz"
 check "relocalize --help" "$keyplace" relocalize --help
 check "map" "$keyplace" map "$log" --out "$work/map.kpm"
 check "relocalize (a)" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" --starts 12 \
-  --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png"
+  --threads 2 --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png"
+# The starts run in parallel: one thread gives the same figures and rows, times aside.
+check "relocalize (a), 1 thread" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
+  --starts 12 --threads 1 --json "$work/a1.json" --tsv "$work/a1.tsv"
+check "same JSON at 1 and 2 threads" same_figures "$work/a1.json" "$work/a.json"
+check "same TSV at 1 and 2 threads" same_figures "$work/a1.tsv" "$work/a.tsv"
 check "figure" test -s "$work/a.png"
 check "TSV: one row per start" test "$(($(wc -l <"$work/a.tsv") - 1))" = 12
 check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_fix_m' \
@@ -64,6 +69,8 @@ check "capped: note" grep -q "capped to the 30" "$work/capped.err"
 
 fails_with "no starts" "--starts" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
   --starts 0
+fails_with "negative threads" "--threads" "$keyplace" relocalize --map "$work/map.kpm" \
+  --log "$log" --threads -1
 fails_with "bad range" "--scans" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
   --scans 5:x
 fails_with "bad config key" "localization.fix.nope" "$keyplace" relocalize --map "$work/map.kpm" \

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "keyplace/eval/localization.hpp"
+#include "keyplace/localization/relocalizer.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "place/submap_query.hpp"
@@ -165,6 +166,37 @@ TEST(GlobalLocalizer, LocalizeNowAnswersFromAnIncompleteQueryAndResetForgetsIt) 
   localizer.Reset();
   EXPECT_EQ(localizer.buffered_scans(), 0u);
   EXPECT_FALSE(localizer.LocalizeNow().has_value());
+}
+
+TEST(Relocalizer, ACopySharesTheRecognizerAndKeepsItsOwnQueryAndFix) {
+  const Bundled& b = BundledLog();
+  Relocalizer original(b.map);
+  for (std::size_t k = 100; k < 104; ++k) {
+    original.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]);
+  }
+  Relocalizer copy = original;  // what RunRelocalization gives each worker
+  EXPECT_EQ(&copy.localizer().recognizer(), &original.localizer().recognizer());  // no rebuild
+  EXPECT_EQ(copy.localizer().buffered_scans(), 4u);
+  copy.Reset();
+  EXPECT_EQ(copy.localizer().buffered_scans(), 0u);
+  EXPECT_EQ(original.localizer().buffered_scans(), 4u);
+  // Fed the same scans, the copy and the original give the same answers.
+  original.Reset();
+  int answers = 0;
+  for (std::size_t k = 300; k < 600; ++k) {
+    const RelocalizationUpdate a =
+        original.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]);
+    const RelocalizationUpdate c =
+        copy.AddScan(b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k]);
+    ASSERT_EQ(a.answer.has_value(), c.answer.has_value()) << k;
+    EXPECT_EQ(a.status, c.status) << k;
+    if (!a.answer) continue;
+    ++answers;
+    EXPECT_EQ(a.answer->submap_id, c.answer->submap_id) << k;
+    EXPECT_EQ(a.answer->confidence, c.answer->confidence) << k;
+  }
+  EXPECT_GT(answers, 3);
+  EXPECT_EQ(original.status(), FixStatus::kFixed);
 }
 
 TEST(GlobalLocalizer, MaxQueryScansClosesAQueryThatNeverCompletes) {

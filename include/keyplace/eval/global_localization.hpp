@@ -35,7 +35,9 @@ struct LocalizationQuery {
   double build_seconds = 0.0;
 };
 
-/// Progress: (queries done, queries in all).
+/// Progress: (queries done, queries in all). The functions below work on their queries in
+/// parallel (TBB; tbb::global_control bounds the threads) and call it from one thread at a time,
+/// with queries done counting up.
 using QueryProgress = std::function<void(std::size_t, std::size_t)>;
 
 /// The start scans of n_pos queries: equally spaced over the scans that have a truth pose, all
@@ -44,6 +46,8 @@ std::vector<int> QueryStarts(const GroundTruth& truth, int n_pos);
 
 /// The submap queries of Algorithm 4 from `starts`, built with the map's mapping configuration.
 /// Stops at the first start whose submap the log ends before completing (as the paper does).
+/// The queries, in the order of `starts`, do not depend on the thread count (build_seconds is
+/// the time of each query's own build).
 std::vector<LocalizationQuery> BuildSubmapQueries(
     const LogInputs& inputs, const GroundTruth& truth, const MappingConfig& mapping,
     const std::vector<int>& starts, PlaceRecognitionConfig::QueryKeypoints query_keypoints,
@@ -118,7 +122,9 @@ struct LocalizationSummary {
 LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, RankBy rank_by);
 
 /// Recognises every query with `recognizer`, skipping the places `rule` calls self-matches. Each
-/// record's `revisitable` is false; MarkRevisitable sets it.
+/// record's `revisitable` is false; MarkRevisitable sets it. The queries are recognised in
+/// parallel; the records, in the order of `queries`, do not depend on the thread count (except
+/// the time fields of PlaceMatch).
 std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQuery>& queries,
                                                 const PlaceRecognizer& recognizer,
                                                 SelfMatchRule rule,

@@ -93,13 +93,16 @@ struct RelocalizationSummary {
   std::size_t lost_on_wrong_track = 0;
 };
 
-/// Progress: (starts done, starts in all).
+/// Progress: (starts done, starts in all), called from one thread at a time, counting up.
 using StartProgress = std::function<void(std::size_t, std::size_t)>;
 
 /// Runs the benchmark on `inputs` (poses = the odometry fed to the localizer, keypoints
 /// extracted) against `map`. With exclude_shared_scans, the localizer's scan ids are the truth
 /// file indices of the scans (GroundTruth::TruthScan) and map submaps sharing one with the
-/// current query are skipped.
+/// current query are skipped. The starts run in parallel (TBB; tbb::global_control bounds the
+/// threads), each on its own copy of one Relocalizer (the recognizer is shared); the records, in
+/// start order, do not depend on the thread count except update_seconds_mean / _max, which time
+/// each AddScan call while other starts run beside it.
 std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs& inputs,
                                            const GroundTruth& truth, const LocalizerConfig& config,
                                            const RelocalizationOptions& options,

@@ -81,6 +81,8 @@ struct LocalizationResult {
 /// `scan_id` passed to AddScan). For evaluations on the map's own log; empty = none.
 using QueryExclusion = std::function<bool(const Place&, const std::vector<int>& query_scan_ids)>;
 
+/// A copy shares the place recognizer and the feature extractor (read-only; safe from several
+/// threads) and has its own query and exclusion.
 class GlobalLocalizer {
  public:
   /// Localizes in `map` with its own mapping configuration. Throws std::invalid_argument for an

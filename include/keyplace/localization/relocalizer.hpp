@@ -106,6 +106,8 @@ class FixFilter {
   double confirmed_at_m_ = 0.0;   // odometry distance of the last confirmation
 };
 
+/// A copy shares the map's place recognizer (read-only; safe from several threads) and has its own
+/// query and fix: one Relocalizer per thread or per robot costs no rebuild of the index.
 class Relocalizer {
  public:
   /// Throws std::invalid_argument for an invalid config (naming the field).
