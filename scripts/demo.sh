@@ -35,5 +35,12 @@ head -3 "$out/localize-stream.txt"
 echo "..."
 tail -1 "$out/localize-stream.txt"
 echo
+echo "== Kidnapped robot on a map recorded earlier: the map of the first half of the log, 12 starts"
+echo "   in the second half; the Relocalizer fixes when two answers agree (keyplace relocalize)"
+"$keyplace" map "$log" --scans 0:732 --out "$out/map-first-half.kpm" >/dev/null
+"$keyplace" relocalize --map "$out/map-first-half.kpm" --log "$log" --scans 732: --starts 12 \
+  --json "$out/relocalize.json" --figure "$out/relocalize.png" | sed -n '3,11p'
+echo
 echo "Outputs in $out: info.json, features.json, keypoints.tsv, map-table2.json, map.kpm, map.png,"
-echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv, localize-stream.txt"
+echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv, localize-stream.txt,"
+echo "map-first-half.kpm, relocalize.json, relocalize.png"

@@ -1,5 +1,6 @@
 #include "relocalize_output.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -18,8 +19,14 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              map.source_log);
   fmt::print("log          {} (scans {}:{}, {} poses as odometry)\n", r.log_path, r.first_scan,
              r.end_scan, ToString(r.pose_source));
+  int last_map_scan = -1;
+  for (const Submap& submap : map.submaps) {
+    for (const int scan : submap.scan_indices) last_map_scan = std::max(last_map_scan, scan);
+  }
+  const bool time_split = static_cast<int>(r.first_scan) > last_map_scan;
   fmt::print("protocol     {}\n",
              !r.query_log_is_map_log ? "another recording than the map's: nothing excluded"
+             : time_split ? "time split: the map's own log, queries after the map's last scan"
              : o.exclude_shared_scans
                  ? "the map's own log: submaps sharing a scan with the query are excluded"
                  : "the map's own log, nothing excluded (self-matches allowed)");
@@ -29,6 +36,8 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              s.fixed_fraction, s.fixed_with_revisit, s.starts_with_revisit, s.fixed);
   fmt::print("to first fix median {:.2f} m, 90th percentile {:.2f} m, median {:.0f} scans\n",
              s.distance_to_fix_median_m, s.distance_to_fix_p90_m, s.scans_to_fix_median);
+  fmt::print("after known  median {:.2f} m, 90th percentile {:.2f} m from the first mapped place\n",
+             s.distance_after_revisit_median_m, s.distance_after_revisit_p90_m);
   fmt::print(
       "fixes        {} checked over {} m after each first fix, {} wrong (rate {:.4f}); "
       "{} wrong first fixes\n",
