@@ -4,6 +4,9 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
+
+#include "io/atomic_file.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -14,12 +17,11 @@ bool IsSvg(const std::string& path) {
 
 }  // namespace
 
-// Creates the surface, draws, writes to a temporary file and renames it onto `path`.
+// Creates the surface, draws, writes to a temporary file and commits it onto `path` (synced,
+// renamed: io/atomic_file.hpp).
 void WriteFigure(const std::string& path, int width_px, int height_px,
                  const std::function<void(cairo_t*)>& draw) {
-  const std::filesystem::path target(path);
-  const std::string temporary =
-      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
+  const std::string temporary = TemporaryPathFor(path);
   const bool svg = IsSvg(path);
   cairo_surface_t* surface =
       svg ? cairo_svg_surface_create(temporary.c_str(), width_px, height_px)
@@ -34,13 +36,16 @@ void WriteFigure(const std::string& path, int width_px, int height_px,
   cairo_surface_finish(surface);
   if (status == CAIRO_STATUS_SUCCESS) status = cairo_surface_status(surface);
   cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) {
-    std::filesystem::remove(temporary);
-    throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
+  try {
+    if (status != CAIRO_STATUS_SUCCESS) {
+      throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
+    }
+    CommitTemporary(temporary, path);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, target, error);
-  if (error) throw std::runtime_error(path + ": cannot rename figure: " + error.message());
 }
 
 void FigureText(cairo_t* cr, double x, double y, const std::string& text, double size) {

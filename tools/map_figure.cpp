@@ -1,16 +1,16 @@
 #include "map_figure.hpp"
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 
 #include <fmt/core.h>
+
+#include "figure_file.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -205,54 +205,23 @@ void DrawHeader(cairo_t* cr, const MapLayout& layout, const GlobalMap& map,
   cairo_show_text(cr, "5 m");
 }
 
-// Writes `surface` (its SVG already streams to `temporary`) and renames `temporary` to `path`;
-// destroys the surface.
-void FinishFigure(cairo_surface_t* surface, bool svg, const std::string& temporary,
-                  const std::string& path) {
-  cairo_status_t status = CAIRO_STATUS_SUCCESS;
-  if (svg) {
-    cairo_surface_finish(surface);
-    status = cairo_surface_status(surface);
-  } else {
-    status = cairo_surface_write_to_png(surface, temporary.c_str());
-  }
-  cairo_surface_destroy(surface);
-  std::error_code error;
-  if (status != CAIRO_STATUS_SUCCESS) {
-    std::filesystem::remove(temporary, error);
-    throw std::runtime_error(path + ": cannot write figure: " + cairo_status_to_string(status));
-  }
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw std::runtime_error(path + ": cannot rename figure: " + error.message());
-}
-
 }  // namespace
 
 void DrawMapFigure(const std::string& path, const GlobalMap& map, const std::vector<LogScan>& scans,
                    const std::vector<Pose2>& poses, const MapFigureOptions& options) {
-  const bool svg = EndsWith(path, ".svg");
-  if (!svg && !EndsWith(path, ".png")) {
+  if (!EndsWith(path, ".svg") && !EndsWith(path, ".png")) {
     throw std::invalid_argument(path + ": figure file name must end in .png or .svg");
   }
   const std::vector<Eigen::Vector2d> points = MapScanPoints(map, scans, poses, options.first_scan);
   const MapLayout layout = FitMap(MapBounds(map, points), options);
 
-  const std::filesystem::path target(path);
-  const std::string temporary =
-      (target.parent_path() / ("." + target.filename().string() + ".tmp")).string();
-  cairo_surface_t* surface =
-      svg ? cairo_svg_surface_create(temporary.c_str(), layout.width_px, layout.height_px)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, layout.width_px, layout.height_px);
-  cairo_t* cr = cairo_create(surface);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
-  DrawScanPoints(cr, layout, points);
-  DrawTrajectory(cr, layout, map);
-  DrawKeypoints(cr, layout, map);
-  DrawOrigins(cr, layout, map);
-  DrawHeader(cr, layout, map, options.title);
-  cairo_destroy(cr);
-  FinishFigure(surface, svg, temporary, path);
+  WriteFigure(path, layout.width_px, layout.height_px, [&](cairo_t* cr) {
+    DrawScanPoints(cr, layout, points);
+    DrawTrajectory(cr, layout, map);
+    DrawKeypoints(cr, layout, map);
+    DrawOrigins(cr, layout, map);
+    DrawHeader(cr, layout, map, options.title);
+  });
 }
 
 }  // namespace keyplace::cli
