@@ -75,9 +75,7 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
     duration_s = log.scans.back().logger_timestamp_s - log.scans.front().logger_timestamp_s;
   }
   json["duration_s"] = duration_s;
-  std::vector<double> stamps;
-  for (const LogScan& scan : log.scans) stamps.push_back(scan.logger_timestamp_s);
-  const TimestampCheck stamp_check = CheckTimestamps(stamps);
+  const TimestampCheck stamp_check = CheckTimestamps(log.scans, TimestampSource::kLogger);
   json["timestamp_warnings"] = stamp_check.warnings;
   json["timestamps_order_scans"] = stamp_check.CanOrder();
   json["path_length_m"] = PathLength(log);

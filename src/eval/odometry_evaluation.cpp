@@ -83,13 +83,9 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
   ValidateScanOdometryConfig(config);
   if (options.order != ScanOrder::kFile) {
     const bool logger = options.order == ScanOrder::kLogger;
-    std::vector<double> stamps;
-    stamps.reserve(scans.size());
-    for (const LogScan& scan : scans) {
-      stamps.push_back(logger ? scan.logger_timestamp_s : scan.timestamp_s);
-    }
-    RequireTimeOrder(CheckTimestamps(stamps),
-                     logger ? "the logger timestamps" : "the ipc timestamps");
+    RequireTimeOrder(
+        CheckTimestamps(scans, logger ? TimestampSource::kLogger : TimestampSource::kIpc),
+        logger ? "the logger timestamps" : "the ipc timestamps");
   }
   const std::vector<std::size_t> order = ProcessingOrder(scans, options.order);
   const std::size_t end = std::min(options.end, order.size());

@@ -131,10 +131,8 @@ SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, Processi
                                 " scans of " + inputs.log.path);
   }
   if (order == ProcessingOrder::kLogger) {
-    std::vector<double> stamps;
-    stamps.reserve(scans.size());
-    for (const LogScan& scan : scans) stamps.push_back(scan.logger_timestamp_s);
-    RequireTimeOrder(CheckTimestamps(stamps), inputs.log.path + ": the logger timestamps");
+    RequireTimeOrder(CheckTimestamps(scans, TimestampSource::kLogger),
+                     inputs.log.path + ": the logger timestamps");
   }
   SlamRun run;
   run.slam = std::make_unique<OnlineSlam>(config);

@@ -65,6 +65,16 @@ TimestampCheck CheckTimestamps(const std::vector<double>& stamps) {
   return check;
 }
 
+TimestampCheck CheckTimestamps(const std::vector<LogScan>& scans, TimestampSource source) {
+  std::vector<double> stamps;
+  stamps.reserve(scans.size());
+  for (const LogScan& scan : scans) {
+    stamps.push_back(source == TimestampSource::kLogger ? scan.logger_timestamp_s
+                                                        : scan.timestamp_s);
+  }
+  return CheckTimestamps(stamps);
+}
+
 void RequireTimeOrder(const TimestampCheck& check, const std::string& what) {
   if (check.CanOrder()) return;
   std::string message = what + " cannot order the scans:";

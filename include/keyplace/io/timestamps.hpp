@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "keyplace/io/carmen_log.hpp"
+
 namespace keyplace {
 
 struct TimestampCheck {
@@ -32,6 +34,10 @@ struct TimestampCheck {
 
 /// `stamps` in file order.
 TimestampCheck CheckTimestamps(const std::vector<double>& stamps);
+
+/// The same for one kind of stamp of a log's scans.
+enum class TimestampSource { kLogger, kIpc };
+TimestampCheck CheckTimestamps(const std::vector<LogScan>& scans, TimestampSource source);
 
 /// Throws std::invalid_argument naming `what` (e.g. "LOG: logger timestamps") and every problem
 /// when `check` cannot order the scans, suggesting `--order file`.
