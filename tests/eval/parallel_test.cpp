@@ -19,6 +19,7 @@
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
+#include "support/bundled_map.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -26,24 +27,8 @@ namespace {
 
 constexpr int kQueries = 80;
 
-// The bundled corrected FR079 log, its map (default mapping) and its ground truth, built once.
-struct Bundled {
-  LogInputs inputs;
-  GlobalMap map;
-  GroundTruth truth;
-};
-
-const Bundled& BundledLog() {
-  static const Bundled bundled = [] {
-    Bundled b;
-    b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
-    b.map =
-        BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
-    b.truth = TruthFromOwnPoses(b.inputs.log);
-    return b;
-  }();
-  return bundled;
-}
+using Bundled = testing::BundledMap;
+const Bundled& BundledLog() { return testing::BundledFr079(); }
 
 // A progress callback that checks it is called one at a time with done = 1, 2, ..., and records
 // the threads it was called from.

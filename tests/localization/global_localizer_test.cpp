@@ -15,27 +15,14 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "place/submap_query.hpp"
+#include "support/bundled_map.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
 namespace {
 
-// The bundled corrected FR079 log, its map (default mapping) and its keypoints, built once.
-struct Bundled {
-  LogInputs inputs;
-  GlobalMap map;
-};
-
-const Bundled& BundledLog() {
-  static const Bundled bundled = [] {
-    Bundled b;
-    b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
-    b.map =
-        BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
-    return b;
-  }();
-  return bundled;
-}
+using Bundled = testing::BundledMap;
+const Bundled& BundledLog() { return testing::BundledFr079(); }
 
 std::vector<int> SortedScans(const std::vector<int>& scans) {
   std::vector<int> sorted = scans;

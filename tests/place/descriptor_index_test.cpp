@@ -18,6 +18,7 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/place/place_recognizer.hpp"
+#include "support/bundled_map.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -128,10 +129,10 @@ struct Bundled {
 const Bundled& BundledLog() {
   static const Bundled bundled = [] {
     Bundled b;
-    b.inputs = PrepareLogInputs(testing::SourceDir() + "/data/fr079-corrected.log.gz");
-    b.map =
-        BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
-    const GroundTruth truth = TruthFromOwnPoses(b.inputs.log);
+    const testing::BundledMap& log = testing::BundledFr079();
+    b.inputs = log.inputs;
+    b.map = log.map;
+    const GroundTruth& truth = log.truth;
     b.queries = BuildSubmapQueries(b.inputs, truth, b.map.config, QueryStarts(truth, 500),
                                    PlaceRecognitionConfig{}.query_keypoints);
     for (const auto& scan : b.inputs.keypoints) {
