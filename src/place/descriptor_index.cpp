@@ -194,35 +194,44 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
     return;
   }
 
-  // kDense: ||u - v||^2 = ||u||^2 + ||v||^2 - 2 u.v for a block of query rows against every
-  // keypoint at once (one matrix product), then the exact test where it is within the radius.
-  const std::size_t n_keypoints = descriptors_.size();
-  const Eigen::Map<const RowMatrix> roots(roots_.data(), static_cast<Eigen::Index>(n_keypoints),
-                                          kBetaGridBins);
-  const std::size_t block = std::clamp<std::size_t>(kProductBudget / n_keypoints, 1, 64);
-  Eigen::MatrixXd dots;  // keypoint x query row of the block, column-major
-  for (std::size_t begin = 0; begin < query.size(); begin += block) {
-    const std::size_t rows = std::min(block, query.size() - begin);
-    dots.resize(static_cast<Eigen::Index>(n_keypoints), static_cast<Eigen::Index>(rows));
-    dots.noalias() =
-        roots *
-        query_roots.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(rows))
-            .transpose();
-    for (std::size_t j = 0; j < rows; ++j) {
-      const std::size_t c = begin + j;
+  // kDense: ||u - v||^2 = ||u||^2 + ||v||^2 - 2 u.v for a block of whole places against every
+  // query row at once (one matrix product), then the exact test where it is within the radius.
+  // Blocks of places, not of query rows: each keypoint's roots are read from memory once per
+  // query however large the map (blocks of query rows reread the whole map per block).
+  const Eigen::Map<const RowMatrix> roots(
+      roots_.data(), static_cast<Eigen::Index>(descriptors_.size()), kBetaGridBins);
+  const std::size_t block_keypoints = std::max<std::size_t>(kProductBudget / query.size(), 1);
+  Eigen::MatrixXd dots;  // keypoint of the block x query row, column-major
+  for (std::size_t first_place = 0; first_place < n_places;) {
+    std::size_t end_place = first_place + 1;
+    const auto begin = static_cast<std::size_t>(first_of_place_[first_place]);
+    while (end_place < n_places &&
+           static_cast<std::size_t>(first_of_place_[end_place + 1]) - begin <= block_keypoints) {
+      ++end_place;
+    }
+    const auto count = static_cast<std::size_t>(first_of_place_[end_place]) - begin;
+    if (count > 0) {
+      dots.resize(static_cast<Eigen::Index>(count), static_cast<Eigen::Index>(query.size()));
+      dots.noalias() =
+          roots.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(count)) *
+          query_roots.transpose();
+    }
+    // Per place, pairs in the exhaustive order: query keypoint, then place keypoint.
+    for (std::size_t c = 0; c < query.size() && count > 0; ++c) {
       const double query_norm = query_norms[static_cast<Eigen::Index>(c)];
       const double radius2 = SearchRadius2(chi2_threshold, query_norm);
-      const double* column = dots.col(static_cast<Eigen::Index>(j)).data();
-      for (std::size_t p = 0; p < n_places; ++p) {
+      const double* column = dots.col(static_cast<Eigen::Index>(c)).data();
+      for (std::size_t p = first_place; p < end_place; ++p) {
         if (!searched[p]) continue;
         const auto end = static_cast<std::size_t>(first_of_place_[p + 1]);
         for (auto k = static_cast<std::size_t>(first_of_place_[p]); k < end; ++k) {
-          if (squared_norms_[k] + query_norm - 2.0 * column[k] < radius2) {
+          if (squared_norms_[k] + query_norm - 2.0 * column[k - begin] < radius2) {
             AddIfBelow(query[c], static_cast<int>(c), k, chi2_threshold, below);
           }
         }
       }
     }
+    first_place = end_place;
   }
 }
 
