@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "config_options.hpp"
 #include "io/atomic_file.hpp"
+#include "keyplace/eval/distractor_map.hpp"
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "localize_output.hpp"
@@ -42,6 +43,8 @@ struct LocalizeOptions {
   std::optional<double> lambda;
   std::optional<double> min_confidence;
   std::string descriptor_index;
+  std::vector<std::string> distractor_paths;
+  std::size_t distractor_submaps = 0;
   int n_pos = 500;
   bool exclude_shared_scans = false;
 };
@@ -63,14 +66,32 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
   return aliases;
 }
 
+// The map among copies of the distractor maps' submaps, far away (the scale benchmark).
+GlobalMap WithDistractors(GlobalMap map, const std::vector<std::string>& paths,
+                          std::size_t total_submaps) {
+  if (total_submaps <= map.submaps.size()) {
+    throw std::invalid_argument(
+        fmt::format("--distractor-submaps {} must exceed the map's {} submaps", total_submaps,
+                    map.submaps.size()));
+  }
+  std::vector<GlobalMap> sources;
+  for (const std::string& path : paths) sources.push_back(LoadMap(path));
+  DistractorOptions distractors;
+  distractors.total_submaps = total_submaps;
+  return EmbedAmongDistractors(map, sources, distractors);
+}
+
 void RunLocalize(const LocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> input_paths = {options.query.log_path, options.query.truth_path,
+                                          options.query.index_path, options.map_path};
+  input_paths.insert(input_paths.end(), options.distractor_paths.begin(),
+                     options.distractor_paths.end());
   CheckOutputs({{"--json", options.json_path},
                 {"--queries", options.queries_path},
                 {"--curve", options.curve_path},
                 {"--reliability", options.reliability_path}},
-               {options.query.log_path, options.query.truth_path, options.query.index_path,
-                options.map_path});
+               input_paths);
   const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
                                     WorkerThreads(options.query.threads));
   const bool baseline = !options.baseline.empty();
@@ -121,9 +142,14 @@ void RunLocalize(const LocalizeOptions& options) {
           "self-match exclusion)\n",
           map.source_log);
     }
-    places = PlacesFromMap(map);
     map_description = fmt::format("{} ({} submaps, {} keypoints)", options.map_path,
                                   map.submaps.size(), map.KeypointCount());
+    if (!options.distractor_paths.empty()) {
+      map = WithDistractors(std::move(map), options.distractor_paths, options.distractor_submaps);
+      map_description += fmt::format(" among distractors: {} submaps, {} keypoints",
+                                     map.submaps.size(), map.KeypointCount());
+    }
+    places = PlacesFromMap(map);
     map_scans = std::move(map.submaps);
     Progress progress("query submaps", starts.size());
     queries = BuildSubmapQueries(inputs, truth, map.config, starts, config.place.query_keypoints,
@@ -215,6 +241,19 @@ void RegisterLocalizeCommand(CLI::App& app) {
                    "Alias of --set place.descriptor_index=X: dense (default), kdtree or none "
                    "(exhaustive; all find the same pairs)")
       ->check(CLI::IsMember({"dense", "kdtree", "none"}));
+  CLI::Option* distractors =
+      command
+          ->add_option("--distractors", options->distractor_paths,
+                       "Map files (.kpm, comma-separated) whose submaps are copied, moved far away "
+                       "(one rigid transform per copy), among the map's: the scale benchmark "
+                       "(docs/BENCHMARKS.md, \"Map size\")")
+          ->check(CLI::ExistingFile)
+          ->delimiter(',');
+  command
+      ->add_option("--distractor-submaps", options->distractor_submaps,
+                   "Submaps of the map with its distractors, the map's own included")
+      ->needs(distractors);
+  distractors->needs("--distractor-submaps");
   AddConfigOptions(command, options->config);
   command->add_option("--n-pos", options->n_pos, "Number of queries")->capture_default_str();
   command->add_flag("--exclude-shared-scans", options->exclude_shared_scans,

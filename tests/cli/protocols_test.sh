@@ -94,6 +94,20 @@ check "same name, other contents" sh -c "'$keyplace' localize --map '$work/first
   --log '$work/copy/fr079-corrected.log.gz' --scans 0:200 --n-pos 3 2>&1 >/dev/null \
   | grep -q 'built from a file named fr079-corrected.log.gz with other contents'"
 
+# The scale benchmark's maps: the first half's map among copies of the second half's submaps.
+check "map --scans 700:" "$keyplace" map "$log" --scans 700: --out "$work/second.kpm"
+check "localize among distractors" "$keyplace" localize --map "$work/first.kpm" --log "$log" \
+  --scans 0:700 --n-pos 10 --distractors "$work/second.kpm" --distractor-submaps 400 \
+  --json "$work/distractors.json"
+check "distractors json" python3 -c "
+import json,sys
+j=json.load(open(sys.argv[1]))
+assert j['places'] == 400 and j['n_pos'] == 10 and j['n_acc'] > 0, j" "$work/distractors.json"
+fails_with "too few distractor submaps" "must exceed the map's" "$keyplace" localize \
+  --map "$work/first.kpm" --log "$log" --distractors "$work/second.kpm" --distractor-submaps 5
+fails_with "distractors without a size" "distractor-submaps" "$keyplace" localize \
+  --map "$work/first.kpm" --log "$log" --distractors "$work/second.kpm"
+
 fails_with "bad localize --scans" "--scans" "$keyplace" localize --map "$work/first.kpm" \
   --log "$log" --scans 700
 fails_with "empty map --scans" "no scan in the range" "$keyplace" map "$log" --scans 2000:
