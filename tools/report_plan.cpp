@@ -221,7 +221,8 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
               needs.push_back(log);
             }
             args.insert(args.end(), {"--preset", preset, "--lambda", LambdaText(lambda), "--mu",
-                                     std::to_string(mu), "--n-pos", n_pos, "--json", out});
+                                     std::to_string(mu), "--n-pos", n_pos, "--threads", threads,
+                                     "--json", out});
             const std::string table =
                 mu == 5 ? "Table X"
                         : (raw_queries ? (lambda < 0.07 ? "Table VII" : "Table VIII")
@@ -241,16 +242,16 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
       steps.push_back({"localize-" + base + "-tip-flirt",
                        "Table X, TIP-FLIRT baseline, " + f.name,
                        {"localize", "--baseline", "tip-flirt", "--log", log, "--n-pos", n_pos,
-                        "--json", A::TipFlirt(s, base)},
+                        "--threads", threads, "--json", A::TipFlirt(s, base)},
                        {log},
                        {A::TipFlirt(s, base)}});
-      steps.push_back(
-          {"localize-" + base + "-tip-flirt-mu5",
-           "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
-           {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
-            "place.min_consensus=5", "--n-pos", n_pos, "--json", A::TipFlirt(s, base, 5)},
-           {log},
-           {A::TipFlirt(s, base, 5)}});
+      steps.push_back({"localize-" + base + "-tip-flirt-mu5",
+                       "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
+                       {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
+                        "place.min_consensus=5", "--n-pos", n_pos, "--threads", threads, "--json",
+                        A::TipFlirt(s, base, 5)},
+                       {log},
+                       {A::TipFlirt(s, base, 5)}});
     }
     // The kidnapped robot (not in the paper): the corrected log against its own map with the
     // shared-scan exclusion, and the raw log with ICP odometry against the corrected map.
@@ -267,7 +268,8 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
         args.insert(args.end(), {"--log", log, "--self-match", "shared-scan"});
         needs.push_back(log);
       }
-      args.insert(args.end(), {"--starts", starts, "--json", json, "--figure", png});
+      args.insert(args.end(),
+                  {"--starts", starts, "--threads", threads, "--json", json, "--figure", png});
       steps.push_back(
           {"relocalize-" + base + (raw_queries ? "-raw" : ""),
            raw_queries

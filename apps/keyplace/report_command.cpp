@@ -64,7 +64,9 @@ void RegisterReportCommand(CLI::App& app) {
                     "\"not computed\"");
   command->add_flag("--quick", options->quick,
                     "20 queries instead of 500 and small sweep grids (tests, a first look)");
-  command->add_option("--threads", options->threads, "Threads of the sweeps (0 = all cores)")
+  command
+      ->add_option("--threads", options->threads,
+                   "Threads of the sweeps, localize and relocalize steps (0 = all cores)")
       ->capture_default_str();
   command
       ->add_option("--stability-scan", options->stability_scan,

@@ -41,7 +41,8 @@ TEST(ReportPlanTest, RelocalizesTheCorrectedLogAgainstItsOwnMap) {
   const ReportStep& step = steps[k];
   EXPECT_EQ(CommandLine(step),
             "keyplace relocalize --map /work/maps/fr079.kpm --log /data/fr079-corrected.log.gz "
-            "--self-match shared-scan --starts 50 --json /work/relocalize/fr079.json --figure "
+            "--self-match shared-scan --starts 50 --threads 0 --json /work/relocalize/fr079.json "
+            "--figure "
             "/work/relocalize/fr079.png");
   EXPECT_EQ(step.needs,
             (std::vector<std::string>{"/work/maps/fr079.kpm", "/data/fr079-corrected.log.gz"}));
@@ -61,7 +62,7 @@ TEST(ReportPlanTest, RelocalizesTheRawLogWithIcpOdometryAgainstTheCorrectedMap) 
   EXPECT_EQ(CommandLine(step),
             "keyplace relocalize --map /work/maps/intel.kpm --log /data/intel-raw.log.gz --poses "
             "icp --truth /data/intel-corrected.log.gz --index /data/intel-raw-to-corrected.tsv "
-            "--starts 50 --json /work/relocalize/intel-raw.json --figure "
+            "--starts 50 --threads 0 --json /work/relocalize/intel-raw.json --figure "
             "/work/relocalize/intel-raw.png");
   EXPECT_EQ(step.needs, (std::vector<std::string>{"/work/maps/intel.kpm", "/data/intel-raw.log.gz",
                                                   "/data/intel-corrected.log.gz",
@@ -83,6 +84,21 @@ TEST(ReportPlanTest, QuickReportsUseFewStarts) {
     ASSERT_NE(starts + 1, step.args.end()) << step.id;
     EXPECT_EQ(*(starts + 1), "6") << step.id;
   }
+}
+
+TEST(ReportPlanTest, LocalizeAndRelocalizeStepsUseTheReportsThreads) {
+  ReportSettings settings = Settings(false);
+  settings.threads = 3;
+  int steps_with_queries = 0;
+  for (const ReportStep& step : PlanReport(settings)) {
+    if (step.args[0] != "localize" && step.args[0] != "relocalize") continue;
+    ++steps_with_queries;
+    const auto threads = std::find(step.args.begin(), step.args.end(), "--threads");
+    ASSERT_NE(threads, step.args.end()) << step.id;
+    ASSERT_NE(threads + 1, step.args.end()) << step.id;
+    EXPECT_EQ(*(threads + 1), "3") << step.id;
+  }
+  EXPECT_GT(steps_with_queries, 20);
 }
 
 TEST(ReportPlanTest, RelocalizeStepsWithoutDataAreSkipped) {
