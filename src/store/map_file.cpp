@@ -3,26 +3,24 @@
 #include <sqlite3.h>
 #include <zlib.h>
 
-#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
-#include <string_view>
-#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "io/atomic_file.hpp"
 #include "store/map_checksum.hpp"
+#include "store/map_file_checks.hpp"
+#include "store/map_schema.hpp"
+#include "store/sqlite_database.hpp"
 
 namespace keyplace {
 namespace {
@@ -31,167 +29,8 @@ constexpr const char* kFormatName = "keyplace-map";
 // Version 1 has the same tables and no content checksum; it is still read.
 constexpr int kOldestReadableVersion = 1;
 
-constexpr const char* kSchema = R"sql(
-CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE config (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE submaps (
-  id INTEGER PRIMARY KEY,
-  overlap REAL NOT NULL,
-  distribution REAL NOT NULL,
-  forced INTEGER NOT NULL,
-  occupancy_cell_m REAL NOT NULL,
-  occupancy_cells INTEGER NOT NULL,
-  occupancy BLOB NOT NULL        -- zlib-compressed int32 (i, j) pairs, little endian
-);
-CREATE TABLE poses (
-  submap_id INTEGER NOT NULL REFERENCES submaps(id),
-  seq INTEGER NOT NULL,
-  scan_index INTEGER NOT NULL,
-  x REAL NOT NULL, y REAL NOT NULL, theta REAL NOT NULL,  -- T_world_robot
-  PRIMARY KEY (submap_id, seq)
-);
-CREATE TABLE keypoints (
-  submap_id INTEGER NOT NULL REFERENCES submaps(id),
-  seq INTEGER NOT NULL,
-  x REAL NOT NULL, y REAL NOT NULL, orientation REAL NOT NULL,  -- submap frame
-  scale REAL NOT NULL,
-  level INTEGER NOT NULL,
-  scan_index INTEGER NOT NULL,
-  stability REAL NOT NULL,
-  occurrences INTEGER NOT NULL,
-  descriptor BLOB NOT NULL,      -- 48 float32, little endian, phi-major
-  PRIMARY KEY (submap_id, seq)
-);
-)sql";
-
-// The tables in checksum order, with the primary key that orders their rows.
-struct TableKey {
-  const char* name;
-  const char* order_by;
-};
-constexpr std::array<TableKey, 5> kTables = {{{"meta", "key"},
-                                              {"config", "key"},
-                                              {"submaps", "id"},
-                                              {"poses", "submap_id, seq"},
-                                              {"keypoints", "submap_id, seq"}}};
-
 // deflate expands at most 1032:1 (a 258-byte match per ~2-bit code); zlib adds 6 bytes.
 constexpr std::uint64_t kMaxDeflateRatio = 1032;
-// SQLite calls the progress handler every this many virtual-machine instructions.
-constexpr int kInstructionsPerProgressCall = 1000;
-// Instructions a load may spend per byte of file, and at least: a safety net that ends a runaway
-// query should the schema check ever let one through. Loading the bundled FR079 map (1.5 MB)
-// takes 0.37 M instructions, 0.24 per byte (SQLite's integrity check is one instruction).
-constexpr std::uint64_t kInstructionsPerFileByte = 64;
-constexpr std::uint64_t kMinInstructions = 10'000'000;
-
-class Database {
- public:
-  Database(const std::string& filename, int flags, std::string display_path)
-      : display_path_(std::move(display_path)) {
-    if (sqlite3_open_v2(filename.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
-      const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
-      sqlite3_close(db_);
-      db_ = nullptr;
-      throw std::runtime_error(display_path_ + ": cannot open map file: " + message);
-    }
-  }
-  ~Database() { sqlite3_close(db_); }
-  Database(const Database&) = delete;
-  Database& operator=(const Database&) = delete;
-
-  [[noreturn]] void Fail(const std::string& what) const {
-    if (sqlite3_errcode(db_) == SQLITE_INTERRUPT) {
-      throw std::runtime_error(display_path_ + ": " + what +
-                               ": reading needed more SQLite steps than a map file of this size "
-                               "can (hostile or damaged file)");
-    }
-    throw std::runtime_error(display_path_ + ": " + what + ": " + sqlite3_errmsg(db_));
-  }
-
-  void Execute(const char* sql) {
-    char* error = nullptr;
-    if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
-      const std::string message = error != nullptr ? error : "unknown error";
-      sqlite3_free(error);
-      throw std::runtime_error(display_path_ + ": " + message);
-    }
-  }
-
-  sqlite3* get() const { return db_; }
-  const std::string& display_path() const { return display_path_; }
-
- private:
-  sqlite3* db_ = nullptr;
-  std::string display_path_;
-};
-
-class Statement {
- public:
-  Statement(const Database& db, const std::string& sql) : db_(db) {
-    if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
-      db.Fail("cannot prepare '" + sql + "'");
-    }
-  }
-  ~Statement() { sqlite3_finalize(statement_); }
-  Statement(const Statement&) = delete;
-  Statement& operator=(const Statement&) = delete;
-
-  Statement& Bind(int index, double value) {
-    Check(sqlite3_bind_double(statement_, index, value));
-    return *this;
-  }
-  Statement& Bind(int index, std::int64_t value) {
-    Check(sqlite3_bind_int64(statement_, index, value));
-    return *this;
-  }
-  Statement& Bind(int index, int value) { return Bind(index, static_cast<std::int64_t>(value)); }
-  Statement& Bind(int index, const std::string& value) {
-    Check(sqlite3_bind_text(statement_, index, value.c_str(), static_cast<int>(value.size()),
-                            SQLITE_TRANSIENT));
-    return *this;
-  }
-  Statement& BindBlob(int index, const void* data, std::size_t size) {
-    Check(sqlite3_bind_blob(statement_, index, data, static_cast<int>(size), SQLITE_TRANSIENT));
-    return *this;
-  }
-
-  // Runs an INSERT/UPDATE to completion and resets for the next row.
-  void Run() {
-    if (sqlite3_step(statement_) != SQLITE_DONE) db_.Fail("write failed");
-    sqlite3_reset(statement_);
-    sqlite3_clear_bindings(statement_);
-  }
-
-  // Next result row of a query; false at the end.
-  bool Step() {
-    const int code = sqlite3_step(statement_);
-    if (code == SQLITE_ROW) return true;
-    if (code == SQLITE_DONE) return false;
-    db_.Fail("read failed (truncated or corrupt map file?)");
-  }
-
-  int Type(int column) const { return sqlite3_column_type(statement_, column); }
-  double Double(int column) const { return sqlite3_column_double(statement_, column); }
-  std::int64_t Int(int column) const { return sqlite3_column_int64(statement_, column); }
-  std::string Text(int column) const {
-    const auto* text = sqlite3_column_text(statement_, column);
-    return text != nullptr ? reinterpret_cast<const char*>(text) : "";
-  }
-  // The bytes stay valid until the next Step.
-  std::pair<const unsigned char*, std::size_t> Bytes(int column) const {
-    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(statement_, column));
-    const int size = sqlite3_column_bytes(statement_, column);
-    return {data, data != nullptr ? static_cast<std::size_t>(size) : 0};
-  }
-
- private:
-  void Check(int code) const {
-    if (code != SQLITE_OK) db_.Fail("cannot bind a value");
-  }
-  const Database& db_;
-  sqlite3_stmt* statement_ = nullptr;
-};
 
 // Little-endian packing (the only byte order keyplace runs on; checked at compile time).
 static_assert(sizeof(float) == 4, "float32 expected");
@@ -214,301 +53,12 @@ std::vector<unsigned char> PackOccupancy(const OccupancySummary& occupancy) {
   return packed;
 }
 
-class Fnv1a64 {
- public:
-  void Bytes(const void* data, std::size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < size; ++k) {
-      state_ ^= bytes[k];
-      state_ *= kPrime;
-    }
-  }
-  // Fixed width and byte order, so that the checksum does not depend on the machine.
-  void Uint64(std::uint64_t value) {
-    std::array<unsigned char, 8> little_endian{};
-    for (std::size_t k = 0; k < little_endian.size(); ++k) {
-      little_endian[k] = static_cast<unsigned char>(value >> (8 * k));
-    }
-    Bytes(little_endian.data(), little_endian.size());
-  }
-  std::uint64_t value() const { return state_; }
-
- private:
-  static constexpr std::uint64_t kOffsetBasis = 14695981039346656037ULL;
-  static constexpr std::uint64_t kPrime = 1099511628211ULL;
-  std::uint64_t state_ = kOffsetBasis;
-};
-
-std::string Hex64(std::uint64_t value) {
-  std::array<char, 17> text{};
-  std::snprintf(text.data(), text.size(), "%016llx", static_cast<unsigned long long>(value));
-  return text.data();
-}
-
 // ---------------------------------------------------------------------------------------------
 // Reading. Everything in the file is checked before it is used: the SQLite header against the
 // file size, the schema against the one SaveMap writes (so that no view, trigger or virtual
 // table of a hostile file is ever run), SQLite's integrity check, the version, the checksum, the
-// stored configuration, and then every value and blob of every row.
-
-std::uint32_t BigEndian(const unsigned char* bytes, int count) {
-  std::uint32_t value = 0;
-  for (int k = 0; k < count; ++k) value = (value << 8) | bytes[k];
-  return value;
-}
-
-struct FileFacts {
-  std::uint64_t bytes = 0;
-  std::uint32_t page_bytes = 0;
-};
-
-// The parts of the SQLite header (sqlite.org/fileformat.html) that keep a damaged or truncated
-// file from reaching SQLite, and files in write-ahead-log mode from creating -wal / -shm files.
-FileFacts CheckFileHeader(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw std::runtime_error(path + ": map file not found (or not a regular file)");
-  }
-  FileFacts facts;
-  facts.bytes = std::filesystem::file_size(path, error);
-  if (error) throw std::runtime_error(path + ": cannot read the map file's size");
-  std::array<unsigned char, 100> header{};
-  std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(header.data()), header.size());
-  if (in.gcount() != static_cast<std::streamsize>(header.size()) ||
-      std::memcmp(header.data(), "SQLite format 3", 16) != 0) {
-    throw std::runtime_error(path + ": not a keyplace map file (not an SQLite database)");
-  }
-  const std::uint32_t page_field = BigEndian(&header[16], 2);
-  facts.page_bytes = page_field == 1 ? 65536 : page_field;
-  if (facts.page_bytes < 512 || (facts.page_bytes & (facts.page_bytes - 1)) != 0) {
-    throw std::runtime_error(path + ": damaged map file: page size " +
-                             std::to_string(facts.page_bytes) + " in the SQLite header");
-  }
-  if (header[18] != 1 || header[19] != 1) {
-    throw std::runtime_error(path +
-                             ": not a map file keyplace wrote: SQLite file format versions " +
-                             std::to_string(header[18]) + "/" + std::to_string(header[19]) +
-                             " (keyplace writes 1/1, rollback journal; 2/2 is write-ahead log)");
-  }
-  if (facts.bytes % facts.page_bytes != 0) {
-    throw std::runtime_error(
-        path + ": truncated or damaged map file: " + std::to_string(facts.bytes) +
-        " bytes is not a whole number of " + std::to_string(facts.page_bytes) + "-byte pages");
-  }
-  const std::uint32_t change_counter = BigEndian(&header[24], 4);
-  const std::uint32_t header_pages = BigEndian(&header[28], 4);
-  const std::uint32_t valid_for = BigEndian(&header[92], 4);
-  // The page count in the header is valid only when written with the current change counter.
-  if (valid_for == change_counter && header_pages != 0 &&
-      std::uint64_t{header_pages} * facts.page_bytes != facts.bytes) {
-    throw std::runtime_error(path + ": truncated or damaged map file: its header counts " +
-                             std::to_string(header_pages) + " pages of " +
-                             std::to_string(facts.page_bytes) + " bytes, the file holds " +
-                             std::to_string(facts.bytes) + " bytes");
-  }
-  return facts;
-}
-
-// An SQLite URI that opens `path` read-only and immutable: no lock, no journal and no -wal/-shm
-// file is read or created, so a hot journal beside a map cannot make a read write the map.
-std::string ImmutableUri(const std::string& path) {
-  static constexpr std::string_view kPlain = "/-._~";
-  std::string uri = "file://";  // empty authority, then the absolute path
-  for (const char c : std::filesystem::absolute(path).string()) {
-    const auto byte = static_cast<unsigned char>(c);
-    if ((byte >= 'a' && byte <= 'z') || (byte >= 'A' && byte <= 'Z') ||
-        (byte >= '0' && byte <= '9') || kPlain.find(c) != std::string_view::npos) {
-      uri += c;
-    } else {
-      std::array<char, 4> escaped{};
-      std::snprintf(escaped.data(), escaped.size(), "%%%02X", byte);
-      uri += escaped.data();
-    }
-  }
-  return uri + "?immutable=1";
-}
-
-struct StepBudget {
-  std::uint64_t calls = 0;
-  std::uint64_t max_calls = 0;
-};
-
-int CountSteps(void* budget_pointer) {
-  auto* budget = static_cast<StepBudget*>(budget_pointer);
-  return ++budget->calls > budget->max_calls ? 1 : 0;
-}
-
-// Settings made before the schema is first read, so that no part of a hostile file runs:
-// views and triggers disabled, functions in the schema untrusted, no writes, bounded values.
-void HardenConnection(Database& db, std::uint64_t file_bytes, StepBudget& budget) {
-  sqlite3* handle = db.get();
-  for (const auto& [option, value] :
-       {std::pair{SQLITE_DBCONFIG_ENABLE_VIEW, 0}, std::pair{SQLITE_DBCONFIG_ENABLE_TRIGGER, 0},
-        std::pair{SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0}, std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1},
-        std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0}}) {
-    if (sqlite3_db_config(handle, option, value, nullptr) != SQLITE_OK) {
-      db.Fail("cannot configure SQLite");
-    }
-  }
-  // No value read from a file can be longer than the file.
-  const auto max_length = static_cast<int>(
-      std::min<std::uint64_t>(std::max<std::uint64_t>(file_bytes, 1 << 16), 1'000'000'000));
-  sqlite3_limit(handle, SQLITE_LIMIT_LENGTH, max_length);
-  sqlite3_limit(handle, SQLITE_LIMIT_ATTACHED, 0);
-  sqlite3_limit(handle, SQLITE_LIMIT_WORKER_THREADS, 0);
-  sqlite3_limit(handle, SQLITE_LIMIT_COLUMN, 100);
-  sqlite3_limit(handle, SQLITE_LIMIT_EXPR_DEPTH, 100);
-  sqlite3_limit(handle, SQLITE_LIMIT_COMPOUND_SELECT, 10);
-  budget.max_calls = std::max(kMinInstructions, kInstructionsPerFileByte * file_bytes) /
-                     kInstructionsPerProgressCall;
-  sqlite3_progress_handler(handle, kInstructionsPerProgressCall, CountSteps, &budget);
-  db.Execute("PRAGMA query_only = ON; PRAGMA trusted_schema = OFF; PRAGMA cell_size_check = ON;");
-}
-
-struct SchemaObject {
-  std::string type;
-  std::string name;
-  std::string table;
-  std::string sql;
-  bool operator==(const SchemaObject& other) const {
-    return std::tie(type, name, table, sql) ==
-           std::tie(other.type, other.name, other.table, other.sql);
-  }
-};
-
-struct Column {
-  std::string name;
-  std::string type;
-  std::int64_t not_null = 0;
-  std::int64_t primary_key = 0;
-  std::int64_t hidden = 0;  // 2 and 3: generated columns
-  bool operator==(const Column& other) const {
-    return std::tie(name, type, not_null, primary_key, hidden) ==
-           std::tie(other.name, other.type, other.not_null, other.primary_key, other.hidden);
-  }
-};
-
-std::vector<SchemaObject> ReadSchemaObjects(const Database& db) {
-  std::vector<SchemaObject> objects;
-  Statement query(db, "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, name");
-  while (query.Step()) {
-    objects.push_back({query.Text(0), query.Text(1), query.Text(2), query.Text(3)});
-  }
-  return objects;
-}
-
-// Only called for names of kTables after they were found to be ordinary tables: a view's or a
-// virtual table's columns would need its query or module.
-std::vector<Column> ReadColumns(const Database& db, const std::string& table) {
-  std::vector<Column> columns;
-  Statement query(db, "PRAGMA table_xinfo(" + table + ")");
-  while (query.Step()) {
-    columns.push_back({query.Text(1), query.Text(2), query.Int(3), query.Int(5), query.Int(6)});
-  }
-  return columns;
-}
-
-std::string Describe(const std::vector<Column>& columns) {
-  std::string text;
-  for (const Column& column : columns) {
-    if (!text.empty()) text += ", ";
-    text += column.name + " " + column.type;
-    if (column.not_null != 0) text += " NOT NULL";
-    if (column.primary_key != 0) text += " PRIMARY KEY";
-    if (column.hidden != 0) text += " (hidden or generated)";
-  }
-  return text;
-}
-
-// The schema SaveMap writes, read back from an in-memory database built from kSchema: the
-// expectation is the writer's own text, never a second copy of it.
-struct ReferenceSchema {
-  std::vector<SchemaObject> objects;
-  std::map<std::string, std::vector<Column>> columns;
-};
-
-const ReferenceSchema& Reference() {
-  static const ReferenceSchema reference = [] {
-    Database db(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_MEMORY, "(map schema)");
-    db.Execute(kSchema);
-    ReferenceSchema schema;
-    schema.objects = ReadSchemaObjects(db);
-    for (const TableKey& table : kTables) schema.columns[table.name] = ReadColumns(db, table.name);
-    return schema;
-  }();
-  return reference;
-}
-
-bool IsMapTable(const std::string& name) {
-  return std::any_of(kTables.begin(), kTables.end(),
-                     [&](const TableKey& table) { return name == table.name; });
-}
-
-void CheckSchema(const Database& db) {
-  const std::string& path = db.display_path();
-  const ReferenceSchema& reference = Reference();
-  const std::vector<SchemaObject> objects = ReadSchemaObjects(db);
-  const auto found = [&](const std::string& name) {
-    return std::find_if(objects.begin(), objects.end(),
-                        [&](const SchemaObject& object) { return object.name == name; });
-  };
-  if (found("meta") == objects.end()) {
-    throw std::runtime_error(path + ": not a keyplace map file (no table meta)");
-  }
-  const std::string hint =
-      " (a keyplace map holds only the tables meta, config, submaps, poses and keypoints and "
-      "their primary-key indexes: a hostile or damaged file, not read further)";
-  for (const SchemaObject& object : objects) {
-    if (IsMapTable(object.name)) {
-      if (object.type != "table") {
-        throw std::runtime_error(path + ": '" + object.name + "' is a " + object.type +
-                                 ", not a table" + hint);
-      }
-      if (object.sql.rfind("CREATE TABLE", 0) != 0) {
-        throw std::runtime_error(path + ": table '" + object.name +
-                                 "' is a virtual table, not an ordinary table" + hint);
-      }
-    } else if (std::find(reference.objects.begin(), reference.objects.end(), object) ==
-               reference.objects.end()) {
-      throw std::runtime_error(path + ": unexpected " + object.type + " '" + object.name + "'" +
-                               hint);
-    }
-  }
-  for (const TableKey& table : kTables) {
-    if (found(table.name) == objects.end()) {
-      throw std::runtime_error(path + ": table '" + std::string(table.name) + "' is missing");
-    }
-    const std::vector<Column> columns = ReadColumns(db, table.name);
-    const std::vector<Column>& expected = reference.columns.at(table.name);
-    if (columns != expected) {
-      throw std::runtime_error(path + ": table '" + std::string(table.name) + "' has columns (" +
-                               Describe(columns) + "), expected (" + Describe(expected) + ")");
-    }
-  }
-  // Same columns, but constraints, defaults or collations may still differ: compare the text.
-  for (const SchemaObject& object : reference.objects) {
-    const auto it = found(object.name);
-    if (it == objects.end() || !(*it == object)) {
-      throw std::runtime_error(path + ": " + object.type + " '" + object.name +
-                               "' is not defined as keyplace defines it" + hint);
-    }
-  }
-}
-
-void CheckIntegrity(const Database& db) {
-  Statement check(db, "PRAGMA integrity_check(10)");
-  std::string problems;
-  while (check.Step()) {
-    const std::string line = check.Text(0);
-    if (line == "ok") continue;
-    problems += (problems.empty() ? "" : "; ") + line;
-  }
-  if (!problems.empty()) {
-    throw std::runtime_error(db.display_path() +
-                             ": damaged map file: SQLite integrity check failed: " + problems);
-  }
-}
+// stored configuration, and then every value and blob of every row. The checks before the first
+// row is read are in map_file_checks.cpp.
 
 template <typename Integer>
 bool ParseInteger(const std::string& text, Integer& value) {
@@ -630,17 +180,17 @@ class MapReader {
       : path_(path), passed_(passed), schema_version_(schema_version) {}
 
   GlobalMap Read() {
-    const FileFacts facts = CheckFileHeader(path_);
+    const MapFileFacts facts = CheckMapFileHeader(path_);
     file_bytes_ = facts.bytes;
     Passed("SQLite header: " + std::to_string(facts.bytes) + " bytes, " +
            std::to_string(facts.page_bytes) + "-byte pages, rollback journal");
-    Database db(ImmutableUri(path_), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, path_);
-    HardenConnection(db, file_bytes_, budget_);
-    CheckSchema(db);
+    Database db(ImmutableMapUri(path_), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, path_);
+    HardenMapConnection(db, file_bytes_, budget_);
+    CheckMapSchema(db);
     Passed(
         "schema: the tables meta, config, submaps, poses and keypoints with their columns and "
         "declared types, no view, trigger or other object");
-    CheckIntegrity(db);
+    CheckMapIntegrity(db);
     Passed("SQLite integrity_check: ok");
     GlobalMap map;
     const int version = ReadMeta(db, map);
@@ -865,7 +415,7 @@ class MapReader {
 void WriteAll(Database& db, const GlobalMap& map) {
   db.Execute("PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;");
   db.Execute("BEGIN;");
-  db.Execute(kSchema);
+  db.Execute(kMapSchema);
   Statement meta(db, "INSERT INTO meta (key, value) VALUES (?, ?)");
   {
     const std::vector<std::pair<std::string, std::string>> entries = {
@@ -945,56 +495,6 @@ void WriteAll(Database& db, const GlobalMap& map) {
 }
 
 }  // namespace
-
-std::string MapContentChecksum(sqlite3* db) {
-  Fnv1a64 hash;
-  for (const TableKey& table : kTables) {
-    std::string sql = std::string("SELECT * FROM ") + table.name;
-    if (std::string_view(table.name) == "meta") {
-      sql += " WHERE key <> '" + std::string(kMapChecksumKey) + "'";
-    }
-    sql += std::string(" ORDER BY ") + table.order_by;
-    sqlite3_stmt* statement = nullptr;
-    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &statement, nullptr) != SQLITE_OK) {
-      throw std::runtime_error(std::string("table ") + table.name + ": " + sqlite3_errmsg(db));
-    }
-    struct Finalize {
-      sqlite3_stmt* statement;
-      ~Finalize() { sqlite3_finalize(statement); }
-    } finalize{statement};
-    hash.Bytes(table.name, std::strlen(table.name) + 1);
-    std::uint64_t rows = 0;
-    int code = SQLITE_ROW;
-    while ((code = sqlite3_step(statement)) == SQLITE_ROW) {
-      ++rows;
-      const int columns = sqlite3_column_count(statement);
-      for (int column = 0; column < columns; ++column) {
-        const int type = sqlite3_column_type(statement, column);
-        hash.Uint64(static_cast<std::uint64_t>(type));
-        if (type == SQLITE_INTEGER) {
-          hash.Uint64(static_cast<std::uint64_t>(sqlite3_column_int64(statement, column)));
-        } else if (type == SQLITE_FLOAT) {
-          const double value = sqlite3_column_double(statement, column);
-          std::uint64_t bits = 0;
-          std::memcpy(&bits, &value, sizeof(bits));
-          hash.Uint64(bits);
-        } else if (type == SQLITE_TEXT || type == SQLITE_BLOB) {
-          const void* data = type == SQLITE_TEXT
-                                 ? static_cast<const void*>(sqlite3_column_text(statement, column))
-                                 : sqlite3_column_blob(statement, column);
-          const auto size = static_cast<std::size_t>(sqlite3_column_bytes(statement, column));
-          hash.Uint64(size);
-          if (size > 0) hash.Bytes(data, size);
-        }
-      }
-    }
-    if (code != SQLITE_DONE) {
-      throw std::runtime_error(std::string("table ") + table.name + ": " + sqlite3_errmsg(db));
-    }
-    hash.Uint64(rows);
-  }
-  return "fnv1a64:" + Hex64(hash.value());
-}
 
 void SaveMap(const GlobalMap& map, const std::string& path) {
   const std::string temporary = TemporaryPathFor(path);
