@@ -283,7 +283,7 @@ void ExpectRejected(const std::string& path, std::initializer_list<const char*> 
 }
 
 std::string SavedRandomMap(const std::string& name) {
-  const std::string path = testing::MakeTempDir("mapfile") + "/" + name;
+  std::string path = testing::MakeTempDir("mapfile") + "/" + name;
   SaveMap(RandomMap(4, 11), path);
   return path;
 }
@@ -446,7 +446,7 @@ TEST(MapFile, StoredConfigIsValidatedLikeAUsersNamingFileAndKey) {
 TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
   // A NaN float32 (0x7fc00000, little endian) in the first bin of a 192-byte descriptor.
   const std::string kNanDescriptor = "UPDATE keypoints SET descriptor = x'0000c07f" +
-                                     std::string(2 * 188, '0') + "' WHERE rowid = 8";
+                                     std::string(std::size_t{2} * 188, '0') + "' WHERE rowid = 8";
   const struct {
     const char* sql;
     std::initializer_list<const char*> expected;
