@@ -1,5 +1,6 @@
 #include "keyplace/mapping/mapping_config.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -16,17 +17,25 @@ void Require(bool ok, const std::string& field, const std::string& rule) {
 }  // namespace
 
 void Validate(const MappingConfig& config) {
-  Require(config.cell_size_m > 0.0, "cell_size_m", "must be positive");
-  Require(config.min_stability >= 0.0, "min_stability", "must be >= 0");
+  // Written so that NaN fails every comparison; isfinite for the fields without an upper bound.
+  Require(config.cell_size_m >= kMinCellSizeM && config.cell_size_m <= kMaxCellSizeM, "cell_size_m",
+          "must lie in [0.01, 10] m (docs/MAPPING.md)");
+  Require(std::isfinite(config.min_stability) && config.min_stability >= 0.0, "min_stability",
+          "must be finite and >= 0");
   Require(config.min_scan_count >= 1, "min_scan_count", "must be >= 1");
-  Require(config.descriptor_match_chi2 > 0.0, "descriptor_match_chi2", "must be positive");
+  Require(std::isfinite(config.descriptor_match_chi2) && config.descriptor_match_chi2 > 0.0,
+          "descriptor_match_chi2", "must be finite and positive");
   Require(config.min_overlap >= 0.0 && config.min_overlap <= 1.0, "min_overlap",
           "must lie in [0, 1]");
-  Require(config.max_distribution >= 0.0, "max_distribution", "must be >= 0");
-  Require(config.distribution_cell_m > 0.0, "distribution_cell_m", "must be positive");
+  Require(std::isfinite(config.max_distribution) && config.max_distribution >= 0.0,
+          "max_distribution", "must be finite and >= 0");
+  Require(config.distribution_cell_m >= kMinCellSizeM &&
+              config.distribution_cell_m <= kMaxDistributionCellM,
+          "distribution_cell_m", "must lie in [0.01, 100] m (docs/MAPPING.md)");
   Require(config.min_stable_keypoints >= 0, "min_stable_keypoints", "must be >= 0");
   Require(config.max_scans_per_submap >= 0, "max_scans_per_submap", "must be >= 0");
-  Require(config.max_grid_cells >= 1, "max_grid_cells", "must be >= 1");
+  Require(config.max_grid_cells >= 1 && config.max_grid_cells <= kMaxGridCellsLimit,
+          "max_grid_cells", "must lie in [1, 2^28] (docs/MAPPING.md)");
 }
 
 }  // namespace keyplace

@@ -3,155 +3,34 @@
 #include <sqlite3.h>
 #include <zlib.h>
 
+#include <array>
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "store/map_checksum.hpp"
+#include "store/map_file_checks.hpp"
+#include "store/map_schema.hpp"
+#include "store/sqlite_database.hpp"
 
 namespace keyplace {
 namespace {
 
 constexpr const char* kFormatName = "keyplace-map";
+// Version 1 has the same tables and no content checksum; it is still read.
+constexpr int kOldestReadableVersion = 1;
 
-constexpr const char* kSchema = R"sql(
-CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE config (key TEXT PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE submaps (
-  id INTEGER PRIMARY KEY,
-  overlap REAL NOT NULL,
-  distribution REAL NOT NULL,
-  forced INTEGER NOT NULL,
-  occupancy_cell_m REAL NOT NULL,
-  occupancy_cells INTEGER NOT NULL,
-  occupancy BLOB NOT NULL        -- zlib-compressed int32 (i, j) pairs, little endian
-);
-CREATE TABLE poses (
-  submap_id INTEGER NOT NULL REFERENCES submaps(id),
-  seq INTEGER NOT NULL,
-  scan_index INTEGER NOT NULL,
-  x REAL NOT NULL, y REAL NOT NULL, theta REAL NOT NULL,  -- T_world_robot
-  PRIMARY KEY (submap_id, seq)
-);
-CREATE TABLE keypoints (
-  submap_id INTEGER NOT NULL REFERENCES submaps(id),
-  seq INTEGER NOT NULL,
-  x REAL NOT NULL, y REAL NOT NULL, orientation REAL NOT NULL,  -- submap frame
-  scale REAL NOT NULL,
-  level INTEGER NOT NULL,
-  scan_index INTEGER NOT NULL,
-  stability REAL NOT NULL,
-  occurrences INTEGER NOT NULL,
-  descriptor BLOB NOT NULL,      -- 48 float32, little endian, phi-major
-  PRIMARY KEY (submap_id, seq)
-);
-)sql";
-
-class Database {
- public:
-  Database(const std::string& path, int flags, std::string display_path)
-      : display_path_(std::move(display_path)) {
-    if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
-      const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
-      sqlite3_close(db_);
-      db_ = nullptr;
-      throw std::runtime_error(display_path_ + ": cannot open map file: " + message);
-    }
-  }
-  ~Database() { sqlite3_close(db_); }
-  Database(const Database&) = delete;
-  Database& operator=(const Database&) = delete;
-
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw std::runtime_error(display_path_ + ": " + what + ": " + sqlite3_errmsg(db_));
-  }
-
-  void Execute(const char* sql) {
-    char* error = nullptr;
-    if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
-      const std::string message = error != nullptr ? error : "unknown error";
-      sqlite3_free(error);
-      throw std::runtime_error(display_path_ + ": " + message);
-    }
-  }
-
-  sqlite3* get() const { return db_; }
-  const std::string& display_path() const { return display_path_; }
-
- private:
-  sqlite3* db_ = nullptr;
-  std::string display_path_;
-};
-
-class Statement {
- public:
-  Statement(const Database& db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db.get(), sql, -1, &statement_, nullptr) != SQLITE_OK) {
-      db.Fail(std::string("cannot prepare '") + sql + "'");
-    }
-  }
-  ~Statement() { sqlite3_finalize(statement_); }
-  Statement(const Statement&) = delete;
-  Statement& operator=(const Statement&) = delete;
-
-  Statement& Bind(int index, double value) {
-    Check(sqlite3_bind_double(statement_, index, value));
-    return *this;
-  }
-  Statement& Bind(int index, std::int64_t value) {
-    Check(sqlite3_bind_int64(statement_, index, value));
-    return *this;
-  }
-  Statement& Bind(int index, int value) { return Bind(index, static_cast<std::int64_t>(value)); }
-  Statement& Bind(int index, const std::string& value) {
-    Check(sqlite3_bind_text(statement_, index, value.c_str(), static_cast<int>(value.size()),
-                            SQLITE_TRANSIENT));
-    return *this;
-  }
-  Statement& BindBlob(int index, const void* data, std::size_t size) {
-    Check(sqlite3_bind_blob(statement_, index, data, static_cast<int>(size), SQLITE_TRANSIENT));
-    return *this;
-  }
-
-  // Runs an INSERT/UPDATE to completion and resets for the next row.
-  void Run() {
-    if (sqlite3_step(statement_) != SQLITE_DONE) db_.Fail("write failed");
-    sqlite3_reset(statement_);
-    sqlite3_clear_bindings(statement_);
-  }
-
-  // Next result row of a query; false at the end.
-  bool Step() {
-    const int code = sqlite3_step(statement_);
-    if (code == SQLITE_ROW) return true;
-    if (code == SQLITE_DONE) return false;
-    db_.Fail("read failed (truncated or corrupt map file?)");
-  }
-
-  double Double(int column) const { return sqlite3_column_double(statement_, column); }
-  std::int64_t Int(int column) const { return sqlite3_column_int64(statement_, column); }
-  std::string Text(int column) const {
-    const auto* text = sqlite3_column_text(statement_, column);
-    return text != nullptr ? reinterpret_cast<const char*>(text) : "";
-  }
-  std::vector<unsigned char> Blob(int column) const {
-    const auto* data = static_cast<const unsigned char*>(sqlite3_column_blob(statement_, column));
-    const int size = sqlite3_column_bytes(statement_, column);
-    return data != nullptr ? std::vector<unsigned char>(data, data + size)
-                           : std::vector<unsigned char>();
-  }
-
- private:
-  void Check(int code) const {
-    if (code != SQLITE_OK) db_.Fail("cannot bind a value");
-  }
-  const Database& db_;
-  sqlite3_stmt* statement_ = nullptr;
-};
+// deflate expands at most 1032:1 (a 258-byte match per ~2-bit code); zlib adds 6 bytes.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
 
 // Little-endian packing (the only byte order keyplace runs on; checked at compile time).
 static_assert(sizeof(float) == 4, "float32 expected");
@@ -174,33 +53,371 @@ std::vector<unsigned char> PackOccupancy(const OccupancySummary& occupancy) {
   return packed;
 }
 
-std::vector<Eigen::Vector2i> UnpackOccupancy(const std::vector<unsigned char>& packed,
-                                             std::int64_t cell_count, const std::string& where) {
-  if (cell_count < 0 || cell_count > (1LL << 28)) {
-    throw std::runtime_error(where + ": implausible occupancy cell count");
+// ---------------------------------------------------------------------------------------------
+// Reading. Everything in the file is checked before it is used: the SQLite header against the
+// file size, the schema against the one SaveMap writes (so that no view, trigger or virtual
+// table of a hostile file is ever run), SQLite's integrity check, the version, the checksum, the
+// stored configuration, and then every value and blob of every row. The checks before the first
+// row is read are in map_file_checks.cpp.
+
+template <typename Integer>
+bool ParseInteger(const std::string& text, Integer& value) {
+  const char* end = text.data() + text.size();
+  const auto result = std::from_chars(text.data(), end, value);
+  return !text.empty() && result.ec == std::errc() && result.ptr == end;
+}
+
+// One row of a query, with the checks every value goes through: its storage class, finite
+// numbers, integer ranges; an error names the file, table, row id and column.
+class Row {
+ public:
+  Row(const Statement& query, const std::string& path, const char* table)
+      : query_(query), path_(path), table_(table), rowid_(query.Int(0)) {}
+
+  [[noreturn]] void Fail(const char* column, const std::string& problem) const {
+    throw std::runtime_error(path_ + ": table " + table_ + ", row " + std::to_string(rowid_) +
+                             ", column " + column + ": " + problem);
   }
-  std::vector<std::int32_t> raw(static_cast<std::size_t>(cell_count) * 2);
-  uLongf raw_bytes = static_cast<uLongf>(raw.size() * sizeof(std::int32_t));
-  const uLongf expected = raw_bytes;
-  if (!packed.empty() || cell_count > 0) {
-    if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &raw_bytes, packed.data(),
-                   static_cast<uLong>(packed.size())) != Z_OK ||
-        raw_bytes != expected) {
-      throw std::runtime_error(where + ": corrupt occupancy data");
+
+  double Real(int index, const char* column) const {
+    if (query_.Type(index) != SQLITE_FLOAT) Fail(column, "not a real number");
+    const double value = query_.Double(index);
+    if (!std::isfinite(value)) Fail(column, "not a finite number (" + std::to_string(value) + ")");
+    return value;
+  }
+  std::int64_t Integer(int index, const char* column, std::int64_t min, std::int64_t max) const {
+    if (query_.Type(index) != SQLITE_INTEGER) Fail(column, "not an integer");
+    const std::int64_t value = query_.Int(index);
+    if (value < min || value > max) {
+      Fail(column, std::to_string(value) + " outside [" + std::to_string(min) + ", " +
+                       std::to_string(max) + "]");
     }
+    return value;
   }
+  int Int(int index, const char* column) const {
+    return static_cast<int>(Integer(index, column, 0, std::numeric_limits<int>::max()));
+  }
+  std::pair<const unsigned char*, std::size_t> Blob(int index, const char* column) const {
+    if (query_.Type(index) != SQLITE_BLOB) Fail(column, "not a blob");
+    return query_.Bytes(index);
+  }
+  std::string Text(int index, const char* column) const {
+    if (query_.Type(index) != SQLITE_TEXT) Fail(column, "not text");
+    return query_.Text(index);
+  }
+
+ private:
+  const Statement& query_;
+  const std::string& path_;
+  const char* table_;
+  std::int64_t rowid_;
+};
+
+// Streams the zlib blob into cells, checking as it goes, so that a blob that expands beyond its
+// declared cells or repeats a cell (a zlib bomb is a long run of equal bytes) stops at once
+// instead of after allocating what it expands to. SaveMap writes the cells of G row by row, so
+// they are strictly increasing in (j, i).
+std::vector<Eigen::Vector2i> InflateOccupancy(const Row& row, const unsigned char* packed,
+                                              std::size_t packed_bytes,
+                                              std::int64_t declared_cells) {
+  constexpr std::size_t kCellBytes = 2 * sizeof(std::int32_t);
+  z_stream stream{};
+  if (inflateInit(&stream) != Z_OK) row.Fail("occupancy", "cannot start zlib");
+  struct EndInflate {
+    z_stream* stream;
+    ~EndInflate() { inflateEnd(stream); }
+  } end_inflate{&stream};
+  stream.next_in = const_cast<Bytef*>(packed);  // zlib's API is not const-correct
+  stream.avail_in = static_cast<uInt>(packed_bytes);
   std::vector<Eigen::Vector2i> cells;
-  cells.reserve(static_cast<std::size_t>(cell_count));
-  for (std::size_t k = 0; k + 1 < raw.size(); k += 2) cells.emplace_back(raw[k], raw[k + 1]);
+  std::array<unsigned char, 8192 * kCellBytes> buffer{};
+  std::size_t pending = 0;  // bytes of an incomplete cell at the front of the buffer
+  for (;;) {
+    stream.next_out = buffer.data() + pending;
+    stream.avail_out = static_cast<uInt>(buffer.size() - pending);
+    const int code = inflate(&stream, Z_NO_FLUSH);
+    if (code != Z_OK && code != Z_STREAM_END) {
+      row.Fail("occupancy", std::string("corrupt zlib data (") +
+                                (stream.msg != nullptr ? stream.msg : "zlib error") + ")");
+    }
+    const std::size_t filled = buffer.size() - stream.avail_out;
+    std::size_t offset = 0;
+    for (; offset + kCellBytes <= filled; offset += kCellBytes) {
+      if (static_cast<std::int64_t>(cells.size()) == declared_cells) {
+        row.Fail("occupancy", "holds more than the " + std::to_string(declared_cells) +
+                                  " cells of occupancy_cells");
+      }
+      std::array<std::int32_t, 2> ij{};
+      std::memcpy(ij.data(), buffer.data() + offset, kCellBytes);
+      if (!cells.empty()) {
+        const Eigen::Vector2i& last = cells.back();
+        if (ij[1] < last.y() || (ij[1] == last.y() && ij[0] <= last.x())) {
+          row.Fail("occupancy", "cell " + std::to_string(cells.size()) + " (" +
+                                    std::to_string(ij[0]) + ", " + std::to_string(ij[1]) +
+                                    ") repeats or precedes the one before it (cells are stored "
+                                    "once each, row by row)");
+        }
+      }
+      cells.emplace_back(ij[0], ij[1]);
+    }
+    pending = filled - offset;
+    std::memmove(buffer.data(), buffer.data() + offset, pending);
+    if (code == Z_STREAM_END) break;
+    if (filled == pending && stream.avail_in == 0) row.Fail("occupancy", "zlib data end early");
+  }
+  if (pending != 0) row.Fail("occupancy", "not a whole number of cells");
+  if (stream.avail_in != 0) row.Fail("occupancy", "bytes after the end of the zlib data");
+  if (static_cast<std::int64_t>(cells.size()) != declared_cells) {
+    row.Fail("occupancy", "holds " + std::to_string(cells.size()) +
+                              " cells, occupancy_cells says " + std::to_string(declared_cells));
+  }
   return cells;
 }
+
+class MapReader {
+ public:
+  MapReader(const std::string& path, std::vector<std::string>* passed, int* schema_version)
+      : path_(path), passed_(passed), schema_version_(schema_version) {}
+
+  GlobalMap Read() {
+    const MapFileFacts facts = CheckMapFileHeader(path_);
+    file_bytes_ = facts.bytes;
+    Passed("SQLite header: " + std::to_string(facts.bytes) + " bytes, " +
+           std::to_string(facts.page_bytes) + "-byte pages, rollback journal");
+    Database db(ImmutableMapUri(path_), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, path_);
+    HardenMapConnection(db, file_bytes_, budget_);
+    CheckMapSchema(db);
+    Passed(
+        "schema: the tables meta, config, submaps, poses and keypoints with their columns and "
+        "declared types, no view, trigger or other object");
+    CheckMapIntegrity(db);
+    Passed("SQLite integrity_check: ok");
+    GlobalMap map;
+    const int version = ReadMeta(db, map);
+    Passed("format " + std::string(kFormatName) + ", version " + std::to_string(version));
+    CheckChecksum(db, version);
+    ReadConfig(db, map);
+    Passed("mapping configuration (table config) valid");
+    ReadRows(db, map);
+    return map;
+  }
+
+ private:
+  void Passed(std::string what) {
+    if (passed_ != nullptr) passed_->push_back(std::move(what));
+  }
+  [[noreturn]] void Fail(const std::string& problem) const {
+    throw std::runtime_error(path_ + ": " + problem);
+  }
+
+  int ReadMeta(const Database& db, GlobalMap& map) {
+    Statement query(db, "SELECT rowid, key, value FROM meta ORDER BY key");
+    while (query.Step()) {
+      const Row row(query, path_, "meta");
+      meta_[row.Text(1, "key")] = row.Text(2, "value");
+    }
+    if (meta_["format"] != kFormatName) Fail("not a keyplace map file (meta format)");
+    int version = 0;
+    if (!ParseInteger(meta_["schema_version"], version) || version < kOldestReadableVersion) {
+      Fail("unknown map schema version '" + meta_["schema_version"] + "'");
+    }
+    if (schema_version_ != nullptr) *schema_version_ = version;
+    if (version > kMapFileSchemaVersion) {
+      Fail("map schema version " + std::to_string(version) +
+           " is not supported: written by a newer keyplace (this keyplace reads versions " +
+           std::to_string(kOldestReadableVersion) + " to " + std::to_string(kMapFileSchemaVersion) +
+           ")");
+    }
+    map.source_log = meta_["source_log"];
+    map.source_hash = meta_["source_hash"];
+    map.pose_source = meta_["pose_source"];
+    map.configuration = meta_["configuration"];
+    if (!ParseInteger(meta_["source_scans"], map.source_scans) ||
+        !ParseInteger(meta_["source_keypoints"], map.source_keypoints)) {
+      Fail("meta table lacks valid source_scans/source_keypoints");
+    }
+    return version;
+  }
+
+  void CheckChecksum(const Database& db, int version) {
+    if (version < 2) {
+      Passed("no content checksum: a version " + std::to_string(version) +
+             " map, written before checksums (keyplace map writes one)");
+      return;
+    }
+    const auto stored = meta_.find(kMapChecksumKey);
+    if (stored == meta_.end()) Fail("damaged map file: no content checksum in table meta");
+    std::string computed;
+    try {
+      computed = MapContentChecksum(db.get());
+    } catch (const std::runtime_error& error) {
+      Fail(std::string("cannot compute the content checksum: ") + error.what());
+    }
+    if (computed != stored->second) {
+      Fail("content checksum mismatch (stored " + stored->second + ", content " + computed +
+           "): the map was changed or damaged after keyplace wrote it");
+    }
+    Passed("content checksum " + computed);
+  }
+
+  void ReadConfig(const Database& db, GlobalMap& map) {
+    std::map<std::string, std::string> config;
+    Statement query(db, "SELECT rowid, key, value FROM config ORDER BY key");
+    while (query.Step()) {
+      const Row row(query, path_, "config");
+      config[row.Text(1, "key")] = row.Text(2, "value");
+    }
+    try {
+      ApplyKeyValues(config, map.config);
+    } catch (const std::invalid_argument& error) {
+      Fail(std::string("table config: ") + error.what());
+    }
+  }
+
+  // Rows of `table` checked against what a file of this size can hold, before any allocation
+  // sized by them (a record takes at least a few bytes of a page).
+  std::size_t CountRows(const Database& db, const char* table) const {
+    Statement query(db, std::string("SELECT count(*) FROM ") + table);
+    const std::uint64_t rows = query.Step() ? static_cast<std::uint64_t>(query.Int(0)) : 0;
+    if (rows > file_bytes_ / 4) {
+      Fail(std::string("table ") + table + " counts " + std::to_string(rows) +
+           " rows, more than a file of " + std::to_string(file_bytes_) + " bytes can hold");
+    }
+    return static_cast<std::size_t>(rows);
+  }
+
+  void ReadRows(const Database& db, GlobalMap& map) {
+    constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
+    map.submaps.reserve(CountRows(db, "submaps"));
+    const std::size_t pose_rows = CountRows(db, "poses");
+    const std::size_t keypoint_rows = CountRows(db, "keypoints");
+    std::map<std::int64_t, std::size_t> index_of_id;
+    std::uint64_t occupancy_cells = 0;
+    {
+      Statement query(db,
+                      "SELECT id, overlap, distribution, forced, occupancy_cell_m, "
+                      "occupancy_cells, occupancy FROM submaps ORDER BY id");
+      while (query.Step()) {
+        const Row row(query, path_, "submaps");
+        Submap submap;
+        submap.id = row.Int(0, "id");
+        submap.overlap = row.Real(1, "overlap");
+        submap.distribution = row.Real(2, "distribution");
+        submap.forced = row.Integer(3, "forced", 0, 1) != 0;
+        submap.occupancy.cell_size_m = row.Real(4, "occupancy_cell_m");
+        if (submap.occupancy.cell_size_m < kMinCellSizeM ||
+            submap.occupancy.cell_size_m > kMaxCellSizeM) {
+          row.Fail("occupancy_cell_m", "outside [0.01, 10] m");
+        }
+        const std::int64_t cells =
+            row.Integer(5, "occupancy_cells", 0, std::numeric_limits<std::int64_t>::max());
+        // Checked before inflating: the cells are those of the submap's grid G, and what the
+        // blob could expand to at zlib's best.
+        if (cells > map.config.max_grid_cells) {
+          row.Fail("occupancy_cells", std::to_string(cells) +
+                                          " cells, more than the grid of a submap holds "
+                                          "(max_grid_cells = " +
+                                          std::to_string(map.config.max_grid_cells) + ")");
+        }
+        const auto [packed, packed_bytes] = row.Blob(6, "occupancy");
+        if (static_cast<std::uint64_t>(cells) * 8 > kMaxDeflateRatio * (packed_bytes + 1)) {
+          row.Fail("occupancy_cells",
+                   std::to_string(cells) + " cells (" + std::to_string(cells * 8) +
+                       " bytes) cannot come from a " + std::to_string(packed_bytes) +
+                       "-byte zlib blob (zlib expands at most 1032:1)");
+        }
+        submap.occupancy.cells = InflateOccupancy(row, packed, packed_bytes, cells);
+        occupancy_cells += submap.occupancy.cells.size();
+        index_of_id[submap.id] = map.submaps.size();
+        map.submaps.push_back(std::move(submap));
+      }
+    }
+    const auto submap_of = [&](const Row& row, std::int64_t id) -> Submap& {
+      const auto it = index_of_id.find(id);
+      if (it == index_of_id.end()) row.Fail("submap_id", "no submap " + std::to_string(id));
+      return map.submaps[it->second];
+    };
+    const auto check_seq = [](const Row& row, std::int64_t seq, std::size_t expected) {
+      if (seq != static_cast<std::int64_t>(expected)) {
+        row.Fail("seq", std::to_string(seq) + ", expected " + std::to_string(expected) +
+                            " (a row is missing or repeated)");
+      }
+    };
+    {
+      Statement query(db,
+                      "SELECT rowid, submap_id, seq, scan_index, x, y, theta FROM poses "
+                      "ORDER BY submap_id, seq");
+      while (query.Step()) {
+        const Row row(query, path_, "poses");
+        Submap& submap = submap_of(row, row.Integer(1, "submap_id", 0, kIntMax));
+        check_seq(row, row.Integer(2, "seq", 0, kIntMax), submap.poses.size());
+        submap.scan_indices.push_back(row.Int(3, "scan_index"));
+        submap.poses.emplace_back(row.Real(4, "x"), row.Real(5, "y"), row.Real(6, "theta"));
+      }
+    }
+    {
+      Statement query(db,
+                      "SELECT rowid, submap_id, seq, x, y, orientation, scale, level, scan_index, "
+                      "stability, occurrences, descriptor FROM keypoints ORDER BY submap_id, seq");
+      while (query.Step()) {
+        const Row row(query, path_, "keypoints");
+        Submap& submap = submap_of(row, row.Integer(1, "submap_id", 0, kIntMax));
+        check_seq(row, row.Integer(2, "seq", 0, kIntMax), submap.keypoints.size());
+        StableKeypoint keypoint;
+        keypoint.position_m = {row.Real(3, "x"), row.Real(4, "y")};
+        keypoint.orientation_rad = row.Real(5, "orientation");
+        keypoint.scale_m = row.Real(6, "scale");
+        keypoint.scale_level = row.Int(7, "level");
+        keypoint.scan_index = row.Int(8, "scan_index");
+        const double stability = row.Real(9, "stability");
+        if (std::abs(stability) > std::numeric_limits<float>::max()) {
+          row.Fail("stability", "beyond float range");
+        }
+        keypoint.stability = static_cast<float>(stability);
+        keypoint.occurrences = row.Int(10, "occurrences");
+        const auto [descriptor, descriptor_bytes] = row.Blob(11, "descriptor");
+        if (descriptor_bytes != sizeof(keypoint.descriptor)) {
+          row.Fail("descriptor", std::to_string(descriptor_bytes) + " bytes, expected " +
+                                     std::to_string(sizeof(keypoint.descriptor)) + " (" +
+                                     std::to_string(keypoint.descriptor.size()) + " float32)");
+        }
+        std::memcpy(keypoint.descriptor.data(), descriptor, descriptor_bytes);
+        for (std::size_t bin = 0; bin < keypoint.descriptor.size(); ++bin) {
+          if (!std::isfinite(keypoint.descriptor[bin])) {
+            row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
+          }
+        }
+        submap.keypoints.push_back(keypoint);
+      }
+    }
+    for (const Submap& submap : map.submaps) {
+      if (submap.poses.empty()) {
+        Fail("submap " + std::to_string(submap.id) + " has no poses");
+      }
+    }
+    Passed(std::to_string(map.submaps.size()) + " submaps, " + std::to_string(pose_rows) +
+           " poses, " + std::to_string(keypoint_rows) + " keypoints, " +
+           std::to_string(occupancy_cells) +
+           " occupancy cells: every value finite and in range, every blob of its size");
+  }
+
+  const std::string& path_;
+  std::vector<std::string>* passed_;
+  int* schema_version_;
+  std::uint64_t file_bytes_ = 0;
+  StepBudget budget_;
+  std::map<std::string, std::string> meta_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Writing.
 
 void WriteAll(Database& db, const GlobalMap& map) {
   db.Execute("PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;");
   db.Execute("BEGIN;");
-  db.Execute(kSchema);
+  db.Execute(kMapSchema);
+  Statement meta(db, "INSERT INTO meta (key, value) VALUES (?, ?)");
   {
-    Statement meta(db, "INSERT INTO meta (key, value) VALUES (?, ?)");
     const std::vector<std::pair<std::string, std::string>> entries = {
         {"format", kFormatName},
         {"schema_version", std::to_string(kMapFileSchemaVersion)},
@@ -266,6 +483,14 @@ void WriteAll(Database& db, const GlobalMap& map) {
           .Run();
     }
   }
+  // Computed from the rows as written, by the same code that checks them on reading.
+  std::string checksum;
+  try {
+    checksum = MapContentChecksum(db.get());
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(db.display_path() + ": " + error.what());
+  }
+  meta.Bind(1, std::string(kMapChecksumKey)).Bind(2, checksum).Run();
   db.Execute("COMMIT;");
 }
 
@@ -289,118 +514,16 @@ void SaveMap(const GlobalMap& map, const std::string& path) {
   }
 }
 
-GlobalMap LoadMap(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) {
-    throw std::runtime_error(path + ": map file not found");
-  }
-  Database db(path, SQLITE_OPEN_READONLY, path);
-  GlobalMap map;
-  std::map<std::string, std::string> meta;
+GlobalMap LoadMap(const std::string& path) { return MapReader(path, nullptr, nullptr).Read(); }
+
+MapFileCheck CheckMapFile(const std::string& path) {
+  MapFileCheck check;
   try {
-    Statement query(db, "SELECT key, value FROM meta");
-    while (query.Step()) meta[query.Text(0)] = query.Text(1);
-  } catch (const std::runtime_error& error) {
-    throw std::runtime_error(path + ": not a keyplace map file (" + error.what() + ")");
+    check.map = MapReader(path, &check.passed, &check.schema_version).Read();
+  } catch (const std::exception& error) {
+    check.problem = error.what();
   }
-  if (meta["format"] != kFormatName) throw std::runtime_error(path + ": not a keyplace map file");
-  if (meta["schema_version"] != std::to_string(kMapFileSchemaVersion)) {
-    throw std::runtime_error(path + ": map schema version " + meta["schema_version"] +
-                             " is not supported (this keyplace reads version " +
-                             std::to_string(kMapFileSchemaVersion) + ")");
-  }
-  {
-    Statement check(db, "PRAGMA quick_check");
-    while (check.Step()) {
-      if (check.Text(0) != "ok") {
-        throw std::runtime_error(path + ": corrupt map file: " + check.Text(0));
-      }
-    }
-  }
-  map.source_log = meta["source_log"];
-  map.source_hash = meta["source_hash"];
-  map.pose_source = meta["pose_source"];
-  map.configuration = meta["configuration"];
-  try {
-    map.source_scans = std::stoull(meta.at("source_scans"));
-    map.source_keypoints = std::stoull(meta.at("source_keypoints"));
-  } catch (const std::exception&) {
-    throw std::runtime_error(path + ": meta table lacks source_scans/source_keypoints");
-  }
-  {
-    std::map<std::string, std::string> config;
-    Statement query(db, "SELECT key, value FROM config");
-    while (query.Step()) config[query.Text(0)] = query.Text(1);
-    try {
-      ApplyKeyValues(config, map.config);
-    } catch (const std::invalid_argument& error) {
-      throw std::runtime_error(path + ": " + error.what());
-    }
-  }
-  std::map<std::int64_t, std::size_t> index_of_id;
-  {
-    Statement query(db,
-                    "SELECT id, overlap, distribution, forced, occupancy_cell_m, occupancy_cells, "
-                    "occupancy FROM submaps ORDER BY id");
-    while (query.Step()) {
-      Submap submap;
-      submap.id = static_cast<int>(query.Int(0));
-      submap.overlap = query.Double(1);
-      submap.distribution = query.Double(2);
-      submap.forced = query.Int(3) != 0;
-      submap.occupancy.cell_size_m = query.Double(4);
-      submap.occupancy.cells = UnpackOccupancy(query.Blob(6), query.Int(5),
-                                               path + ": submap " + std::to_string(submap.id));
-      index_of_id[submap.id] = map.submaps.size();
-      map.submaps.push_back(std::move(submap));
-    }
-  }
-  const auto submap_of = [&](std::int64_t id, const char* table) -> Submap& {
-    const auto it = index_of_id.find(id);
-    if (it == index_of_id.end()) {
-      throw std::runtime_error(path + ": " + table + " row refers to missing submap " +
-                               std::to_string(id));
-    }
-    return map.submaps[it->second];
-  };
-  {
-    Statement query(db,
-                    "SELECT submap_id, scan_index, x, y, theta FROM poses ORDER BY submap_id, seq");
-    while (query.Step()) {
-      Submap& submap = submap_of(query.Int(0), "poses");
-      submap.scan_indices.push_back(static_cast<int>(query.Int(1)));
-      submap.poses.emplace_back(query.Double(2), query.Double(3), query.Double(4));
-    }
-  }
-  {
-    Statement query(db,
-                    "SELECT submap_id, x, y, orientation, scale, level, scan_index, stability, "
-                    "occurrences, descriptor FROM keypoints ORDER BY submap_id, seq");
-    while (query.Step()) {
-      Submap& submap = submap_of(query.Int(0), "keypoints");
-      StableKeypoint keypoint;
-      keypoint.position_m = {query.Double(1), query.Double(2)};
-      keypoint.orientation_rad = query.Double(3);
-      keypoint.scale_m = query.Double(4);
-      keypoint.scale_level = static_cast<int>(query.Int(5));
-      keypoint.scan_index = static_cast<int>(query.Int(6));
-      keypoint.stability = static_cast<float>(query.Double(7));
-      keypoint.occurrences = static_cast<int>(query.Int(8));
-      const std::vector<unsigned char> descriptor = query.Blob(9);
-      if (descriptor.size() != sizeof(keypoint.descriptor)) {
-        throw std::runtime_error(path + ": keypoint of submap " + std::to_string(submap.id) +
-                                 " has a descriptor of " + std::to_string(descriptor.size()) +
-                                 " bytes, expected " + std::to_string(sizeof(keypoint.descriptor)));
-      }
-      std::memcpy(keypoint.descriptor.data(), descriptor.data(), descriptor.size());
-      submap.keypoints.push_back(keypoint);
-    }
-  }
-  for (const Submap& submap : map.submaps) {
-    if (submap.poses.empty()) {
-      throw std::runtime_error(path + ": submap " + std::to_string(submap.id) + " has no poses");
-    }
-  }
-  return map;
+  return check;
 }
 
 }  // namespace keyplace

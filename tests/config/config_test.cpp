@@ -80,6 +80,12 @@ TEST(Config, BadFilesNameFileLineAndKey) {
             "my.yaml:3: unknown configuration key 'place.nope'");
   EXPECT_EQ(ErrorOfYaml("mapping:\n  cell_size_m: 0.1\n\n  min_scan_count: four\n"),
             "my.yaml:4: mapping.min_scan_count: 'four' is not an integer");
+  EXPECT_EQ(ErrorOfYaml("mapping:\n  cell_size_m: 0.001\n"),
+            "my.yaml:2: mapping.cell_size_m: MappingConfig.cell_size_m must lie in [0.01, 10] m "
+            "(docs/MAPPING.md)");
+  EXPECT_EQ(ErrorOfYaml("mapping:\n  cell_size_m: inf\n"),
+            "my.yaml:2: mapping.cell_size_m: MappingConfig.cell_size_m must lie in [0.01, 10] m "
+            "(docs/MAPPING.md)");
   EXPECT_EQ(ErrorOfYaml("place:\n  min_gamma: 1.5\n"),
             "my.yaml:2: place.min_gamma: PlaceRecognitionConfig.min_gamma must lie in [0, 1]");
   EXPECT_EQ(ErrorOfYaml("slam:\n  loop_refinement:\n    refine: maybe\n"),
@@ -104,6 +110,8 @@ TEST(Config, AssignmentsAndFilesReportTheirErrors) {
   EXPECT_THROW(ApplyConfigAssignment("min_pairs=3", config), std::invalid_argument);
   EXPECT_THROW(ApplyConfigAssignment("place.min_pairs", config), std::invalid_argument);
   EXPECT_THROW(ApplyConfigAssignment("place.min_pairs=1", config), std::invalid_argument);
+  EXPECT_THROW(ApplyConfigAssignment("mapping.cell_size_m=0.001", config), std::invalid_argument);
+  EXPECT_THROW(ApplyConfigAssignment("mapping.cell_size_m=inf", config), std::invalid_argument);
   try {
     ApplyConfigFile("/nonexistent/config.yaml", config);
     FAIL() << "a missing file was accepted";

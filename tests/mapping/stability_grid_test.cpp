@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <limits>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -237,6 +239,40 @@ TEST(MappingConfig, RejectsInvalidFieldsByName) {
   ApplyKeyValues({{"min_stability", "0.5"}, {"overlap_cells", "observed"}}, parsed);
   EXPECT_DOUBLE_EQ(parsed.min_stability, 0.5);
   EXPECT_EQ(parsed.overlap_cells, MappingConfig::OverlapCells::kObserved);
+}
+
+// A cell side of 0.001 m or inf used to pass "positive" (and came back from a map file's config
+// table), then exhausted memory in localize; every real field must now be finite.
+TEST(MappingConfig, CellSidesAreBoundedAndRealFieldsFinite) {
+  const auto rejected = [](const std::string& key, const std::string& value) {
+    MappingConfig config;
+    try {
+      ApplyKeyValues({{key, value}}, config);
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find("MappingConfig." + key), std::string::npos)
+          << error.what();
+      return true;
+    }
+    return false;
+  };
+  for (const char* value : {"0.001", "0.0099", "10.01", "inf", "-inf", "nan", "0", "-0.1"}) {
+    EXPECT_TRUE(rejected("cell_size_m", value)) << value;
+  }
+  for (const char* value : {"0.001", "100.5", "inf", "nan"}) {
+    EXPECT_TRUE(rejected("distribution_cell_m", value)) << value;
+  }
+  for (const char* key : {"min_stability", "descriptor_match_chi2", "max_distribution"}) {
+    EXPECT_TRUE(rejected(key, "inf")) << key;
+    EXPECT_TRUE(rejected(key, "nan")) << key;
+  }
+  EXPECT_TRUE(rejected("max_grid_cells", "268435457"));  // 2^28 + 1
+  EXPECT_TRUE(rejected("max_grid_cells", "0"));
+  // The bounds themselves are valid, as are the paper's values and the sweep's l_g.
+  for (const char* value : {"0.01", "0.05", "0.1", "0.15", "10"}) {
+    EXPECT_FALSE(rejected("cell_size_m", value)) << value;
+  }
+  EXPECT_FALSE(rejected("distribution_cell_m", "100"));
+  EXPECT_FALSE(rejected("max_grid_cells", "268435456"));
 }
 
 }  // namespace

@@ -1,15 +1,27 @@
 #include "keyplace/store/map_file.hpp"
 
 #include <sqlite3.h>
+#include <sys/resource.h>
+#include <zlib.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iostream>
+#include <iterator>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "store/map_checksum.hpp"
+#include "support/bundled_map.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -61,6 +73,7 @@ void ExpectSameMap(const GlobalMap& a, const GlobalMap& b) {
   EXPECT_EQ(a.pose_source, b.pose_source);
   EXPECT_EQ(a.source_scans, b.source_scans);
   EXPECT_EQ(a.source_keypoints, b.source_keypoints);
+  EXPECT_EQ(a.configuration, b.configuration);
   EXPECT_EQ(ToKeyValues(a.config), ToKeyValues(b.config));
   ASSERT_EQ(a.submaps.size(), b.submaps.size());
   for (std::size_t s = 0; s < a.submaps.size(); ++s) {
@@ -154,6 +167,7 @@ TEST(MapFile, OtherSchemaVersionIsRejected) {
   sqlite3_close(db);
   const std::string message = ErrorOf([&] { LoadMap(path); });
   EXPECT_NE(message.find("schema version 99"), std::string::npos) << message;
+  EXPECT_NE(message.find("newer keyplace"), std::string::npos) << message;
 }
 
 TEST(MapFile, MissingFileAndUnwritablePathAreClearErrors) {
@@ -180,6 +194,404 @@ TEST(MapFile, FailedSaveKeepsTheExistingFile) {
     ++files;
   }
   EXPECT_EQ(files, 1) << "temporary file left behind";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Damaged and hostile files (issue 18). Content changes are resealed with a correct checksum
+// where the check under test comes after the checksum, as a hostile writer could do.
+
+void ExecuteSql(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  const int code = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error);
+  const std::string message = error != nullptr ? error : "";
+  sqlite3_free(error);
+  sqlite3_close(db);
+  ASSERT_EQ(code, SQLITE_OK) << sql << ": " << message;
+}
+
+// Stores the checksum of the present content, as SaveMap would have.
+void Reseal(const std::string& path) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  const std::string checksum = MapContentChecksum(db);
+  sqlite3_close(db);
+  ExecuteSql(path, "UPDATE meta SET value = '" + checksum + "' WHERE key = '" +
+                       std::string(kMapChecksumKey) + "'");
+}
+
+void SetOccupancy(const std::string& path, std::int64_t declared_cells,
+                  const std::vector<unsigned char>& blob) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* statement = nullptr;
+  ASSERT_EQ(
+      sqlite3_prepare_v2(db, "UPDATE submaps SET occupancy_cells = ?, occupancy = ? WHERE id = 0",
+                         -1, &statement, nullptr),
+      SQLITE_OK);
+  sqlite3_bind_int64(statement, 1, declared_cells);
+  sqlite3_bind_blob(statement, 2, blob.data(), static_cast<int>(blob.size()), SQLITE_TRANSIENT);
+  EXPECT_EQ(sqlite3_step(statement), SQLITE_DONE);
+  sqlite3_finalize(statement);
+  sqlite3_close(db);
+}
+
+std::vector<unsigned char> Compressed(const std::vector<unsigned char>& raw, int level) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::vector<unsigned char> packed(size);
+  EXPECT_EQ(compress2(packed.data(), &size, raw.data(), static_cast<uLong>(raw.size()), level),
+            Z_OK);
+  packed.resize(size);
+  return packed;
+}
+
+std::string Bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// What a load must leave as it was: the map's bytes and mtime, and the folder's file list (no
+// -journal, -wal or -shm file appears).
+struct FileState {
+  explicit FileState(const std::string& path)
+      : bytes(Bytes(path)), mtime(std::filesystem::last_write_time(path)) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::filesystem::path(path).parent_path())) {
+      folder.push_back(entry.path().filename().string());
+    }
+    std::sort(folder.begin(), folder.end());
+  }
+  bool operator==(const FileState& other) const {
+    return bytes == other.bytes && mtime == other.mtime && folder == other.folder;
+  }
+  std::string bytes;
+  std::filesystem::file_time_type mtime;
+  std::vector<std::string> folder;
+};
+
+// LoadMap must throw an error naming the file and containing every one of `parts`, and leave the
+// file as it was.
+void ExpectRejected(const std::string& path, std::initializer_list<const char*> parts) {
+  const FileState before(path);
+  const std::string message = ErrorOf([&] { LoadMap(path); });
+  ASSERT_FALSE(message.empty()) << path << " loaded";
+  EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+  for (const char* part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+  EXPECT_TRUE(FileState(path) == before) << "loading changed " << path;
+  EXPECT_EQ(CheckMapFile(path).problem, message);
+}
+
+std::string SavedRandomMap(const std::string& name) {
+  std::string path = testing::MakeTempDir("mapfile") + "/" + name;
+  SaveMap(RandomMap(4, 11), path);
+  return path;
+}
+
+TEST(MapFile, SavedMapsCarryTheVersionAndTheContentChecksum) {
+  const std::string path = SavedRandomMap("map.kpm");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  const std::string computed = MapContentChecksum(db);
+  std::string version;
+  std::string stored;
+  sqlite3_stmt* statement = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "SELECT key, value FROM meta", -1, &statement, nullptr),
+            SQLITE_OK);
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    const std::string key = reinterpret_cast<const char*>(sqlite3_column_text(statement, 0));
+    const std::string value = reinterpret_cast<const char*>(sqlite3_column_text(statement, 1));
+    if (key == "schema_version") version = value;
+    if (key == kMapChecksumKey) stored = value;
+  }
+  sqlite3_finalize(statement);
+  sqlite3_close(db);
+  EXPECT_EQ(version, "2");
+  EXPECT_EQ(stored, computed);
+  EXPECT_EQ(stored.rfind("fnv1a64:", 0), 0u) << stored;
+  EXPECT_EQ(stored.size(), 8u + 16u) << stored;
+  // Another map has another checksum.
+  const std::string other = SavedRandomMap("other.kpm");
+  ExecuteSql(other, "UPDATE poses SET x = 0.5 WHERE rowid = 1");
+  ASSERT_EQ(sqlite3_open_v2(other.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  EXPECT_NE(MapContentChecksum(db), computed);
+  sqlite3_close(db);
+}
+
+TEST(MapFile, CheckMapFileListsEveryCheckOfAValidMap) {
+  const std::string path = SavedRandomMap("map.kpm");
+  const MapFileCheck check = CheckMapFile(path);
+  EXPECT_TRUE(check.ok()) << check.problem;
+  EXPECT_EQ(check.schema_version, 2);
+  ASSERT_EQ(check.passed.size(), 7u);
+  for (const char* part : {"SQLite header", "schema", "integrity_check", "version 2",
+                           "content checksum fnv1a64:", "configuration", "4 submaps"}) {
+    bool found = false;
+    for (const std::string& passed : check.passed) found |= passed.find(part) != std::string::npos;
+    EXPECT_TRUE(found) << part;
+  }
+  ExpectSameMap(RandomMap(4, 11), check.map);
+}
+
+TEST(MapFile, VersionOneMapsWithoutChecksumStillLoad) {
+  const std::string path = SavedRandomMap("v1.kpm");
+  ExecuteSql(path,
+             "DELETE FROM meta WHERE key = 'content_checksum'; "
+             "UPDATE meta SET value = '1' WHERE key = 'schema_version'");
+  ExpectSameMap(RandomMap(4, 11), LoadMap(path));
+  const MapFileCheck check = CheckMapFile(path);
+  EXPECT_EQ(check.schema_version, 1);
+  EXPECT_NE(check.passed.at(4).find("no content checksum: a version 1 map"), std::string::npos);
+}
+
+TEST(MapFile, AChangedValueOrAMissingChecksumIsRejected) {
+  const std::string path = SavedRandomMap("changed.kpm");
+  ExecuteSql(path, "UPDATE poses SET x = x + 1e-9 WHERE rowid = 3");
+  ExpectRejected(path, {"content checksum mismatch (stored fnv1a64:", "changed or damaged"});
+  const std::string missing = SavedRandomMap("missing.kpm");
+  ExecuteSql(missing, "DELETE FROM meta WHERE key = 'content_checksum'");
+  ExpectRejected(missing, {"no content checksum"});
+  const std::string config = SavedRandomMap("config.kpm");
+  ExecuteSql(config, "UPDATE config SET value = '0.2' WHERE key = 'cell_size_m'");
+  ExpectRejected(config, {"content checksum mismatch"});
+}
+
+// Reproducer: the keypoints table replaced by a view over an endless recursive query used to
+// hang keyplace while SQLite's sorter filled the temporary folder. It is rejected before any
+// query touches it (a wrong implementation hangs here until ctest's timeout).
+TEST(MapFile, KeypointsAsAnEndlessViewIsRejectedUnrun) {
+  const std::string path = SavedRandomMap("view.kpm");
+  ExecuteSql(path,
+             "DROP TABLE keypoints; "
+             "CREATE VIEW keypoints (submap_id, seq, x, y, orientation, scale, level, scan_index, "
+             "stability, occurrences, descriptor) AS "
+             "WITH RECURSIVE r(n) AS (SELECT 1 UNION ALL SELECT n + 1 FROM r) "
+             "SELECT 0, n, 0.0, 0.0, 0.0, 1.0, 0, 0, 1.0, 1, zeroblob(192) FROM r");
+  ExpectRejected(path, {"'keypoints' is a view, not a table"});
+}
+
+TEST(MapFile, SchemasOtherThanTheWrittenOneAreRejected) {
+  const std::string kKeypointColumns =
+      "submap_id INTEGER NOT NULL REFERENCES submaps(id), seq INTEGER NOT NULL, x REAL NOT NULL, "
+      "y REAL NOT NULL, orientation REAL NOT NULL, scale REAL NOT NULL, level INTEGER NOT NULL, "
+      "scan_index INTEGER NOT NULL, stability REAL NOT NULL, occurrences INTEGER NOT NULL, ";
+  const struct {
+    const char* name;
+    std::string sql;
+    const char* expected;
+  } cases[] = {
+      {"trigger", "CREATE TRIGGER evil AFTER INSERT ON meta BEGIN DELETE FROM poses; END",
+       "unexpected trigger 'evil'"},
+      {"view", "CREATE VIEW extra AS SELECT 1", "unexpected view 'extra'"},
+      {"index", "CREATE INDEX by_x ON poses (x)", "unexpected index 'by_x'"},
+      {"table", "CREATE TABLE notes (text TEXT)", "unexpected table 'notes'"},
+      {"missing", "DROP TABLE config", "table 'config' is missing"},
+      {"virtual", "DROP TABLE keypoints; CREATE VIRTUAL TABLE keypoints USING rtree(id, a, b)",
+       "'keypoints' is a virtual table"},
+      {"type",
+       "DROP TABLE keypoints; CREATE TABLE keypoints (" + kKeypointColumns +
+           "descriptor TEXT NOT NULL, PRIMARY KEY (submap_id, seq))",
+       "table 'keypoints' has columns ("},
+      {"generated",
+       "DROP TABLE keypoints; CREATE TABLE keypoints (" + kKeypointColumns +
+           "descriptor BLOB NOT NULL, big BLOB GENERATED ALWAYS AS (zeroblob(1000000000)), "
+           "PRIMARY KEY (submap_id, seq))",
+       "(hidden or generated)"},
+      {"check",
+       "DROP TABLE keypoints; CREATE TABLE keypoints (" + kKeypointColumns +
+           "descriptor BLOB NOT NULL CHECK (length(descriptor) = 192), "
+           "PRIMARY KEY (submap_id, seq))",
+       "table 'keypoints' is not defined as keyplace defines it"},
+  };
+  for (const auto& hostile : cases) {
+    SCOPED_TRACE(hostile.name);
+    const std::string path = SavedRandomMap(std::string(hostile.name) + ".kpm");
+    ExecuteSql(path, hostile.sql);
+    ExpectRejected(path, {hostile.expected});
+  }
+}
+
+// A file in write-ahead-log mode would need -wal/-shm files beside it: rejected from its header.
+TEST(MapFile, WriteAheadLogFilesAreRejectedFromTheHeader) {
+  const std::string path = SavedRandomMap("wal.kpm");
+  ExecuteSql(path, "PRAGMA journal_mode = WAL");
+  ExpectRejected(path, {"2/2 is write-ahead log"});
+}
+
+// A hot journal beside a map (a writer killed mid-transaction) is not rolled back into the map:
+// the map is read as it is and stays unchanged.
+TEST(MapFile, AJournalBesideTheMapIsNeitherReadNorApplied) {
+  const std::string path = SavedRandomMap("map.kpm");
+  std::ofstream(path + "-journal", std::ios::binary) << std::string(4096, '\x5a');
+  const FileState before(path);
+  ExpectSameMap(RandomMap(4, 11), LoadMap(path));
+  EXPECT_TRUE(FileState(path) == before);
+}
+
+TEST(MapFile, StoredConfigIsValidatedLikeAUsersNamingFileAndKey) {
+  for (const char* value : {"0.001", "inf", "nan", "1e300"}) {
+    SCOPED_TRACE(value);
+    const std::string path = SavedRandomMap("config.kpm");
+    ExecuteSql(path,
+               std::string("UPDATE config SET value = '") + value + "' WHERE key = 'cell_size_m'");
+    Reseal(path);
+    ExpectRejected(path, {"table config: ", "cell_size_m", "[0.01, 10] m"});
+  }
+  const std::string path = SavedRandomMap("grid.kpm");
+  ExecuteSql(path, "UPDATE config SET value = '1099511627776' WHERE key = 'max_grid_cells'");
+  Reseal(path);
+  ExpectRejected(path, {"table config: ", "max_grid_cells"});
+}
+
+TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
+  // A NaN float32 (0x7fc00000, little endian) in the first bin of a 192-byte descriptor.
+  const std::string kNanDescriptor = "UPDATE keypoints SET descriptor = x'0000c07f" +
+                                     std::string(std::size_t{2} * 188, '0') + "' WHERE rowid = 8";
+  const struct {
+    const char* sql;
+    std::initializer_list<const char*> expected;
+  } cases[] = {
+      {"UPDATE poses SET x = 1e999 WHERE rowid = 3",
+       {"table poses, row 3, column x: not a finite number (inf)"}},
+      {"UPDATE keypoints SET scale = -1e999 WHERE rowid = 5",
+       {"table keypoints, row 5, column scale: not a finite number (-inf)"}},
+      {"UPDATE submaps SET overlap = 'abc' WHERE id = 2",
+       {"table submaps, row 2, column overlap: not a real number"}},
+      {"UPDATE keypoints SET descriptor = zeroblob(191) WHERE rowid = 7",
+       {"table keypoints, row 7, column descriptor: 191 bytes, expected 192 (48 float32)"}},
+      {kNanDescriptor.c_str(),
+       {"table keypoints, row 8, column descriptor: bin 0 is not a finite number"}},
+      {"UPDATE keypoints SET descriptor = hex(descriptor) WHERE rowid = 9",
+       {"table keypoints, row 9, column descriptor: not a blob"}},
+      {"UPDATE keypoints SET level = -1 WHERE rowid = 2",
+       {"table keypoints, row 2, column level: -1 outside [0, 2147483647]"}},
+      {"UPDATE poses SET scan_index = 4294967296 WHERE rowid = 2",
+       {"table poses, row 2, column scan_index: 4294967296 outside"}},
+      {"UPDATE submaps SET forced = 2 WHERE id = 1",
+       {"table submaps, row 1, column forced: 2 outside [0, 1]"}},
+      {"UPDATE submaps SET occupancy_cell_m = 0.001 WHERE id = 3",
+       {"table submaps, row 3, column occupancy_cell_m: outside [0.01, 10] m"}},
+      {"DELETE FROM poses WHERE submap_id = 1 AND seq = 1",
+       {"table poses, row ", "column seq: 2, expected 1 (a row is missing or repeated)"}},
+      {"UPDATE poses SET submap_id = 9 WHERE submap_id = 3",
+       {"table poses, row ", "column submap_id: no submap 9"}},
+      {"DELETE FROM poses WHERE submap_id = 2", {"submap 2 has no poses"}},
+      {"UPDATE meta SET value = '-1' WHERE key = 'source_scans'",
+       {"meta table lacks valid source_scans"}},
+      {"UPDATE submaps SET occupancy_cells = occupancy_cells + 1 WHERE id = 1",
+       {"table submaps, row 1, column occupancy: holds 200 cells, occupancy_cells says 201"}},
+      {"UPDATE submaps SET occupancy_cells = occupancy_cells - 1 WHERE id = 1",
+       {"table submaps, row 1, column occupancy: holds more than the 199 cells"}},
+      {"UPDATE submaps SET occupancy = x'00112233' WHERE id = 0",
+       {"table submaps, row 0, column occupancy: corrupt zlib data"}},
+  };
+  for (const auto& bad : cases) {
+    SCOPED_TRACE(bad.sql);
+    const std::string path = SavedRandomMap("bad.kpm");
+    ExecuteSql(path, bad.sql);
+    Reseal(path);
+    ExpectRejected(path, bad.expected);
+  }
+}
+
+// Cells of a submap in its file order: row-major (j, then i), as SaveMap writes G's cells.
+TEST(MapFile, OccupancyCellsMustBeDistinctAndRowMajor) {
+  const std::string path = SavedRandomMap("order.kpm");
+  std::vector<std::int32_t> raw = {0, 0, 1, 0, 0, 1, 0, 1};  // (0,0) (1,0) (0,1) (0,1)
+  std::vector<unsigned char> bytes(raw.size() * sizeof(std::int32_t));
+  std::memcpy(bytes.data(), raw.data(), bytes.size());
+  SetOccupancy(path, 4, Compressed(bytes, 6));
+  Reseal(path);
+  ExpectRejected(path, {"column occupancy: cell 3 (0, 1) repeats or precedes the one before it"});
+}
+
+// A zlib bomb within every bound on the count (2^20 equal cells, 8 MiB from 36 KiB): stopped at
+// the second cell instead of being expanded (it used to load).
+TEST(MapFile, AZlibBombOfRepeatedCellsIsStoppedAtOnce) {
+  const std::string path = SavedRandomMap("bomb.kpm");
+  const std::int64_t cells = std::int64_t{1} << 20;
+  SetOccupancy(path, cells, Compressed(std::vector<unsigned char>(cells * 8, 0), 1));
+  Reseal(path);
+  ExpectRejected(path, {"table submaps, row 0, column occupancy: cell 1 (0, 0) repeats"});
+}
+
+TEST(MapFile, DeclaredCellCountsBeyondWhatTheBlobOrTheGridCanHoldAreRejected) {
+  // More than max_grid_cells (the default 2^24): the cells of one submap's grid G.
+  const std::string path = SavedRandomMap("count.kpm");
+  SetOccupancy(path, 262'500'000, Compressed(std::vector<unsigned char>(1 << 20, 0), 9));
+  Reseal(path);
+  ExpectRejected(path, {"column occupancy_cells: 262500000 cells, more than the grid of a "
+                        "submap holds (max_grid_cells = 16777216)"});
+  // Within max_grid_cells, but more than 1032 times the blob: deflate cannot expand that much.
+  const std::string ratio = SavedRandomMap("ratio.kpm");
+  SetOccupancy(ratio, std::int64_t{1} << 24, Compressed(std::vector<unsigned char>(4096, 0), 9));
+  Reseal(ratio);
+  ExpectRejected(ratio, {"column occupancy_cells: 16777216 cells (134217728 bytes) cannot come "
+                         "from a ",
+                         "-byte zlib blob (zlib expands at most 1032:1)"});
+}
+
+// Reproducer of the 2.1 GB zlib bomb: a small map declaring 262.5 M occupancy cells. Loading it
+// under 1 GiB of address space must end with the loader's error, not std::bad_alloc (it used to
+// allocate the 2.1 GB the count asks for).
+[[noreturn]] void LoadBombIn1GiB(const std::string& path) {
+  rlimit limit{};
+  limit.rlim_cur = limit.rlim_max = rlim_t{1} << 30;
+  if (setrlimit(RLIMIT_AS, &limit) != 0) std::exit(2);
+  try {
+    LoadMap(path);
+  } catch (const std::runtime_error& error) {
+    std::exit(std::string(error.what()).find("occupancy_cells") != std::string::npos ? 0 : 3);
+  } catch (...) {
+    std::exit(4);
+  }
+  std::exit(5);
+}
+
+TEST(MapFileDeathTest, AZlibBombDeclaringGigabytesLoadsNothing) {
+  ::testing::FLAGS_gtest_death_test_style = "threadsafe";
+  const std::string path = SavedRandomMap("bomb.kpm");
+  SetOccupancy(path, 262'500'000, Compressed(std::vector<unsigned char>(1 << 20, 0), 9));
+  Reseal(path);
+  EXPECT_EXIT(LoadBombIn1GiB(path), ::testing::ExitedWithCode(0), "");
+}
+
+// 30 maps, each the saved bundled FR079 map with one random bit flipped (fixed seed): each is
+// rejected, or, when the flip is in bytes SQLite does not use, loads with exactly the content of
+// the original. No load changes the file. Without the checksum 4 of 30 flips loaded other
+// content without a word.
+TEST(MapFile, EveryBitFlipInTheBundledMapIsRejectedOrHarmless) {
+  const std::string dir = testing::MakeTempDir("mapfile");
+  const std::string original = dir + "/fr079.kpm";
+  SaveMap(testing::BundledFr079().map, original);
+  const GlobalMap reference = LoadMap(original);
+  ExpectSameMap(testing::BundledFr079().map, reference);
+  const std::string bytes = Bytes(original);
+  std::mt19937_64 rng(18);
+  std::uniform_int_distribution<std::size_t> byte_of(0, bytes.size() - 1);
+  std::uniform_int_distribution<int> bit_of(0, 7);
+  int rejected = 0;
+  for (int flip = 0; flip < 30; ++flip) {
+    const std::size_t byte = byte_of(rng);
+    const int bit = bit_of(rng);
+    SCOPED_TRACE("byte " + std::to_string(byte) + " bit " + std::to_string(bit));
+    std::string flipped = bytes;
+    flipped[byte] = static_cast<char>(flipped[byte] ^ (1 << bit));
+    const std::string path = dir + "/flip" + std::to_string(flip) + ".kpm";
+    std::ofstream(path, std::ios::binary) << flipped;
+    const FileState before(path);
+    try {
+      const GlobalMap loaded = LoadMap(path);
+      ExpectSameMap(reference, loaded);
+    } catch (const std::runtime_error& error) {
+      ++rejected;
+      EXPECT_EQ(std::string(error.what()).rfind(path + ": ", 0), 0u) << error.what();
+    }
+    EXPECT_TRUE(FileState(path) == before);
+    std::filesystem::remove(path);
+  }
+  std::cout << rejected << " of 30 bit flips rejected, " << 30 - rejected
+            << " in unused bytes loaded the original content\n";
 }
 
 }  // namespace

@@ -59,7 +59,19 @@ struct MappingConfig {
   std::int64_t max_grid_cells = std::int64_t{1} << 24;
 };
 
-/// Throws std::invalid_argument naming the first invalid field.
+// Bounds of the cell sides (cell_size_m, distribution_cell_m, and the occupancy of a stored
+// submap). Below 1 cm a cell is finer than the range noise of 2D lidars (1-3 cm), so a keypoint
+// cannot reappear in its cell, and G's cell budget (max_grid_cells) would hold less than one scan;
+// above 10 m a cell holds a whole room and "the same cell" means nothing. Both bounds also keep
+// infinite and NaN sides, which passed "positive", out of the grids (docs/MAPPING.md).
+constexpr double kMinCellSizeM = 0.01;
+constexpr double kMaxCellSizeM = 10.0;
+constexpr double kMaxDistributionCellM = 100.0;
+// Upper bound of max_grid_cells: 2^28 cells of 20 bytes (5 GiB), 1.6 km x 1.6 km at l_g = 0.1 m;
+// a submap needing more is a pose glitch, and a stored map cannot ask for more memory than this.
+constexpr std::int64_t kMaxGridCellsLimit = std::int64_t{1} << 28;
+
+/// Throws std::invalid_argument naming the first invalid field. Every real field must be finite.
 void Validate(const MappingConfig& config);
 
 }  // namespace keyplace
