@@ -16,13 +16,13 @@
 
 #include <cstddef>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 #include <tbb/global_control.h>
 
 #include "keyplace/eval/distractor_map.hpp"
@@ -70,12 +70,11 @@ const Bundled& Load() {
   return bundled;
 }
 
-double ResidentMiB() {
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
-  }
-  return 0.0;
+// Heap in use (glibc), not the resident size: freed memory of an earlier, larger map stays
+// resident and would be counted again.
+double HeapInUseMiB() {
+  const struct mallinfo2 info = mallinfo2();
+  return static_cast<double>(info.uordblks + info.hblkhd) / (1024.0 * 1024.0);
 }
 
 // Below the bundled map's own size (238 submaps), its first submaps.
@@ -97,9 +96,10 @@ void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex
   PlaceRecognitionConfig config;
   config.descriptor_index = index;
   // The map is not needed once its places are made; only the recognizer stays, as in a robot.
+  const double heap_before_mib = HeapInUseMiB();
   const auto recognizer = std::make_unique<const keyplace::PlaceRecognizer>(
       keyplace::PlacesFromMap(MapOfSize(b, static_cast<std::size_t>(state.range(0)))), config);
-  const double rss_mib = ResidentMiB();
+  const double recognizer_mib = HeapInUseMiB() - heap_before_mib;
   double pairing = 0.0;
   double verification = 0.0;
   double candidates = 0.0;
@@ -124,7 +124,7 @@ void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex
   state.counters["candidates"] = candidates / n;
   state.counters["correct"] = correct / n;
   state.counters["places"] = static_cast<double>(recognizer->places().size());
-  state.counters["rss_mib"] = rss_mib;
+  state.counters["recognizer_mib"] = recognizer_mib;
 }
 
 using Index = PlaceRecognitionConfig::DescriptorIndex;
