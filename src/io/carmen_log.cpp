@@ -1,10 +1,17 @@
 #include "keyplace/io/carmen_log.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
+#include <array>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -12,18 +19,40 @@
 #include <utility>
 #include <vector>
 
+#include "io/file_fingerprint.hpp"
+
 namespace keyplace {
 namespace {
 
-// Reads a plain or gzip-compressed text file line by line (zlib reads plain files as they are).
+// Reads a plain or gzip-compressed text file line by line, once, front to back: the input may be a
+// pipe or a FIFO (`keyplace info <(zcat log.gz)`), which can be neither reopened nor rewound, so
+// the format is decided from bytes already read and the fingerprint (CRC32 and size of every
+// byte, as FileFingerprint) is taken on the way instead of by a second read.
 class LineReader {
  public:
-  explicit LineReader(const std::string& path) : path_(path), file_(gzopen(path.c_str(), "rb")) {
-    if (file_ == nullptr) throw std::runtime_error(path + ": cannot open file");
-    gzbuffer(file_, 1 << 17);
+  explicit LineReader(const std::string& path) : path_(path), raw_(kBufferBytes) {
+    file_.fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (file_.fd < 0) {
+      throw std::runtime_error(path + ": cannot open file (" + std::strerror(errno) + ")");
+    }
+    struct stat status {};
+    if (fstat(file_.fd, &status) == 0 && S_ISDIR(status.st_mode)) {
+      throw std::runtime_error(path + ": is a directory, not a log file");
+    }
+    regular_ = S_ISREG(status.st_mode);
+    // A pipe may deliver fewer bytes per read than the magic numbers need.
+    EnsureRaw(kSqliteMagic.size());
+    if (raw_end_ >= kSqliteMagic.size() &&
+        std::memcmp(raw_.data(), kSqliteMagic.data(), kSqliteMagic.size()) == 0) {
+      throw std::invalid_argument(
+          path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
+          (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
+    }
+    gzip_ = StartsWithGzipMagic();
+    if (gzip_) StartInflating();
   }
   ~LineReader() {
-    if (file_ != nullptr) gzclose(file_);
+    if (inflating_) inflateEnd(&stream_);
   }
   LineReader(const LineReader&) = delete;
   LineReader& operator=(const LineReader&) = delete;
@@ -31,19 +60,22 @@ class LineReader {
   // Next line without its end-of-line characters; false at the end of the file.
   bool Next(std::string& line) {
     line.clear();
-    char chunk[1 << 14];
-    while (gzgets(file_, chunk, sizeof(chunk)) != nullptr) {
-      line.append(chunk);
-      if (!line.empty() && line.back() == '\n') break;
+    terminated_ = false;
+    while (true) {
+      if (text_begin_ == text_end_ && !FillText()) break;
+      const char* begin = text_ + text_begin_;
+      const auto* newline =
+          static_cast<const char*>(std::memchr(begin, '\n', text_end_ - text_begin_));
+      const std::size_t take = newline != nullptr ? static_cast<std::size_t>(newline - begin) + 1
+                                                  : text_end_ - text_begin_;
+      line.append(begin, take);
+      text_begin_ += take;
+      if (newline != nullptr) {
+        terminated_ = true;
+        break;
+      }
     }
-    terminated_ = !line.empty() && line.back() == '\n';
-    int error_code = Z_OK;
-    const char* message = gzerror(file_, &error_code);
-    if (error_code != Z_OK && error_code != Z_STREAM_END) {
-      throw std::runtime_error(path_ + ": truncated or corrupt compressed data after line " +
-                               std::to_string(line_number_) + " (" + message + ")");
-    }
-    if (line.empty() && gzeof(file_)) return false;
+    if (line.empty()) return false;
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     ++line_number_;
     return true;
@@ -53,9 +85,141 @@ class LineReader {
   // Whether the latest line ended with an end of line (only the file's last line may not).
   bool terminated() const { return terminated_; }
 
+  // Reads what follows the last line (bytes after the compressed data) so that the fingerprint
+  // covers the whole input, then FormatFingerprint of it.
+  std::string Fingerprint() {
+    raw_begin_ = raw_end_ = 0;
+    while (ReadRaw(0) > 0) raw_end_ = 0;
+    return FormatFingerprint(static_cast<std::uint32_t>(crc_), bytes_);
+  }
+  std::uint64_t bytes() const { return bytes_; }
+
  private:
+  static constexpr std::size_t kBufferBytes = 1 << 17;
+  static constexpr std::array<char, 16> kSqliteMagic = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f',
+                                                        'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
+
+  // Appends up to the free space of raw_ after `at` from the input; 0 at its end.
+  std::size_t ReadRaw(std::size_t at) {
+    if (eof_) return 0;
+    while (true) {
+      const ssize_t got = read(file_.fd, raw_.data() + at, raw_.size() - at);
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) {
+        throw std::runtime_error(path_ + ": read error after line " + std::to_string(line_number_) +
+                                 " (" + std::strerror(errno) + ")");
+      }
+      if (got == 0) eof_ = true;
+      const auto count = static_cast<std::size_t>(got);
+      crc_ = crc32(crc_, raw_.data() + at, static_cast<uInt>(count));
+      bytes_ += count;
+      raw_end_ = at + count;
+      return count;
+    }
+  }
+
+  // At least `count` unread raw bytes at raw_begin_, unless the input ends first.
+  void EnsureRaw(std::size_t count) {
+    if (raw_begin_ > 0) {
+      std::memmove(raw_.data(), raw_.data() + raw_begin_, raw_end_ - raw_begin_);
+      raw_end_ -= raw_begin_;
+      raw_begin_ = 0;
+    }
+    while (raw_end_ < count && ReadRaw(raw_end_) > 0) {
+    }
+  }
+
+  bool StartsWithGzipMagic() const {
+    return raw_end_ - raw_begin_ >= 2 && raw_[raw_begin_] == 0x1f && raw_[raw_begin_ + 1] == 0x8b;
+  }
+
+  void StartInflating() {
+    stream_ = z_stream{};
+    // 15 + 16: a gzip wrapper only (a plain file is read as it is, as zlib's gzread does).
+    if (inflateInit2(&stream_, 15 + 16) != Z_OK) {
+      throw std::runtime_error(path_ + ": cannot start gzip decompression");
+    }
+    inflating_ = true;
+  }
+
+  [[noreturn]] void FailCompressed(const std::string& why) const {
+    throw std::runtime_error(path_ + ": truncated or corrupt compressed data after line " +
+                             std::to_string(line_number_) + " (" + why + ")");
+  }
+
+  // Makes more text available in text_[text_begin_, text_end_); false at the end of the input.
+  bool FillText() {
+    if (!gzip_) {
+      if (raw_begin_ == raw_end_ && ReadRaw(0) == 0) return false;
+      text_ = reinterpret_cast<const char*>(raw_.data());
+      text_begin_ = raw_begin_;
+      text_end_ = raw_end_;
+      raw_begin_ = raw_end_ = 0;
+      return true;
+    }
+    if (text_buffer_.empty()) text_buffer_.resize(kBufferBytes);
+    while (true) {
+      if (member_ended_) {
+        // gzip members may be concatenated; anything else after one is ignored, as gzread does.
+        EnsureRaw(2);
+        if (!StartsWithGzipMagic()) return false;
+        inflateReset(&stream_);
+        member_ended_ = false;
+      }
+      if (raw_begin_ == raw_end_) {
+        raw_begin_ = 0;
+        if (ReadRaw(0) == 0) FailCompressed("unexpected end of file");
+      }
+      stream_.next_in = raw_.data() + raw_begin_;
+      stream_.avail_in = static_cast<uInt>(raw_end_ - raw_begin_);
+      stream_.next_out = reinterpret_cast<Bytef*>(text_buffer_.data());
+      stream_.avail_out = static_cast<uInt>(text_buffer_.size());
+      const int result = inflate(&stream_, Z_NO_FLUSH);
+      raw_begin_ = raw_end_ - stream_.avail_in;
+      if (result == Z_STREAM_END) {
+        member_ended_ = true;
+      } else if (result != Z_OK && result != Z_BUF_ERROR) {
+        FailCompressed(stream_.msg != nullptr ? stream_.msg
+                                              : "zlib error " + std::to_string(result));
+      }
+      const std::size_t produced = text_buffer_.size() - stream_.avail_out;
+      if (produced > 0) {
+        text_ = text_buffer_.data();
+        text_begin_ = 0;
+        text_end_ = produced;
+        return true;
+      }
+    }
+  }
+
+  // Closed however the constructor or the reading ends.
+  struct FileDescriptor {
+    int fd = -1;
+    FileDescriptor() = default;
+    FileDescriptor(const FileDescriptor&) = delete;
+    FileDescriptor& operator=(const FileDescriptor&) = delete;
+    ~FileDescriptor() {
+      if (fd >= 0) close(fd);
+    }
+  };
+
   std::string path_;
-  gzFile file_;
+  FileDescriptor file_;
+  bool regular_ = false;
+  bool eof_ = false;
+  std::vector<unsigned char> raw_;  // bytes as read from the input
+  std::size_t raw_begin_ = 0;
+  std::size_t raw_end_ = 0;
+  uLong crc_ = crc32(0L, Z_NULL, 0);
+  std::uint64_t bytes_ = 0;
+  bool gzip_ = false;
+  bool inflating_ = false;
+  bool member_ended_ = false;
+  z_stream stream_{};
+  std::vector<char> text_buffer_;  // decompressed text (gzip input)
+  const char* text_ = nullptr;     // where the unread text lies: raw_ or text_buffer_
+  std::size_t text_begin_ = 0;
+  std::size_t text_end_ = 0;
   std::size_t line_number_ = 0;
   bool terminated_ = true;
 };
@@ -427,6 +591,8 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
                            " (line " + numbers + "); the first: " + first_skipped_error);
   }
   log.lines = reader.line_number();
+  log.fingerprint = reader.Fingerprint();
+  log.file_bytes = reader.bytes();
   switch (options.pose_kind) {
     case CarmenReadOptions::PoseKind::kCorrected:
       log.corrected = true;
