@@ -13,6 +13,8 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -342,9 +344,25 @@ class FieldParser {
   double max_coordinate_m_;
 };
 
+// A PARAM laser_{front,rear}_laser_{fov,resolution} in effect: its number (degrees expected) and
+// the line that set it, for notes and errors.
+struct GeometryParam {
+  double value = 0.0;
+  std::string token;
+  std::size_t line = 0;
+};
+
+struct LaserParams {
+  std::optional<GeometryParam> fov;
+  std::optional<GeometryParam> resolution;
+};
+
 struct ReaderState {
   CarmenLog log;
   CarmenReadOptions options;
+  LaserParams front_laser;
+  LaserParams rear_laser;
+  std::set<std::size_t> noted_param_lines;  // PARAM lines whose reading was already noted
   bool in_loop_edges = false;
   bool saw_corrected_marker = false;
 };
@@ -364,31 +382,129 @@ void ClassifyBeams(LaserScan& scan, CarmenLog& log) {
   }
 }
 
-// The PARAMs that give FLASER/RLASER lines their angles (ParamDegrees): a number there must be
-// a finite angle in (0, 360] degrees (an infinite field of view made every beam angle NaN). A
-// value that is no number, zero or negative keeps being ignored (the defaults apply).
-void CheckLaserGeometryParam(const FieldParser& fields) {
+// The PARAMs that give FLASER/RLASER lines their angles: a number there must be a finite angle
+// in (0, 360] degrees (an infinite field of view made every beam angle NaN). A value that is no
+// number, zero or negative keeps being ignored (the defaults apply). Returns the PARAM's laser and
+// value when it is one of them, to be recorded once the line is accepted.
+std::optional<std::pair<GeometryParam, std::string>> LaserGeometryParam(const FieldParser& fields,
+                                                                        std::size_t line) {
   const std::string name = fields.Token(1);
   if (name != "laser_front_laser_fov" && name != "laser_front_laser_resolution" &&
       name != "laser_rear_laser_fov" && name != "laser_rear_laser_resolution") {
-    return;
+    return std::nullopt;
   }
-  const std::string token = fields.Token(2);
-  double value = 0.0;
-  const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (result.ec != std::errc() || !(value > 0.0)) return;
-  if (!(value <= 360.0)) {
-    fields.Fail(name + " = '" + token + "' is not an angle in (0, 360] degrees");
+  GeometryParam param;
+  param.token = fields.Token(2);
+  param.line = line;
+  const auto result =
+      std::from_chars(param.token.data(), param.token.data() + param.token.size(), param.value);
+  if (result.ec != std::errc() || !(param.value > 0.0)) param.value = 0.0;  // ignored
+  if (!(param.value <= 360.0)) {
+    fields.Fail(name + " = '" + param.token + "' is not an angle in (0, 360] degrees");
+  }
+  return std::make_pair(param, name);
+}
+
+void RecordLaserGeometryParam(const GeometryParam& param, const std::string& name,
+                              ReaderState& state) {
+  LaserParams& laser = name.rfind("laser_front_", 0) == 0 ? state.front_laser : state.rear_laser;
+  std::optional<GeometryParam>& slot =
+      name.size() >= 4 && name.compare(name.size() - 4, 4, "_fov") == 0 ? laser.fov
+                                                                        : laser.resolution;
+  if (param.value > 0.0) {
+    slot = param;
+  } else {
+    slot.reset();
   }
 }
 
-double ParamDegrees(const CarmenLog& log, const std::string& name, double fallback_deg) {
-  const auto it = log.params.find(name);
-  if (it == log.params.end()) return fallback_deg;
-  double value = 0.0;
-  const auto result =
-      std::from_chars(it->second.data(), it->second.data() + it->second.size(), value);
-  return result.ec == std::errc() && value > 0.0 ? value : fallback_deg;
+// Whether a field of view, an angular resolution and a beam count describe one scan. Two
+// conventions are in use: the field of view spans n steps (each beam owns a sector of one
+// resolution: CARMEN's writer, FLIRTLib, and this reader, which spreads FLASER beams from -fov/2
+// in steps of fov/n) or n-1 steps (first to last beam, as a ROS LaserScan's angle_max -
+// angle_min). Both are accepted, widened by half a step (a field of view rounded to the nearest
+// step, whole degrees) and 1 % of the field of view (resolutions written with three significant
+// digits, 0.333 for 1/3 degree, are 0.1 % off; six-decimal radians over 8192 beams 0.07 %). The
+// contradictions that corrupt the geometry are far outside: degrees read as radians are 57x off,
+// a halved resolution or a doubled beam count 2x.
+bool GeometryAgrees(double fov_rad, double resolution_rad, std::size_t beams) {
+  const double step_rad = std::abs(resolution_rad);
+  const double tolerance_rad = 0.5 * step_rad + 0.01 * std::abs(fov_rad);
+  const double n = static_cast<double>(beams);
+  return fov_rad >= (n - 1.0) * step_rad - tolerance_rad && fov_rad <= n * step_rad + tolerance_rad;
+}
+
+std::string Degrees(double angle_rad) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4g", angle_rad * 180.0 / M_PI);
+  return text;
+}
+
+std::string DisagreementText(double fov_rad, double resolution_rad, std::size_t beams) {
+  char steps[32];
+  std::snprintf(steps, sizeof(steps), "%.4g", fov_rad / std::abs(resolution_rad));
+  return "a field of view of " + Degrees(fov_rad) + " degrees spans " + steps +
+         " steps of the resolution " + Degrees(resolution_rad) + " degrees, but " +
+         std::to_string(beams) + " beams need " + std::to_string(beams - 1) + " or " +
+         std::to_string(beams) + " (within half a step + 1 %)";
+}
+
+// The field of view of a FLASER/RLASER line with `beams` beams from the PARAMs in effect, which
+// are checked against each other and the beam count, not trusted. A value at most 2 pi where
+// degrees are expected is a field of view in radians (no 2D lidar sees less than 6.3 degrees):
+// it is read so, with a note. `notes` gets one sentence per PARAM line read as radians.
+double FlaserFieldOfView(const FieldParser& fields, const std::string& path,
+                         const LaserParams& params, const std::string& prefix, std::size_t beams,
+                         std::vector<std::pair<std::size_t, std::string>>& notes) {
+  const auto note = [&](const GeometryParam& param, const std::string& name,
+                        const std::string& why) {
+    notes.emplace_back(param.line, path + ":" + std::to_string(param.line) + ": PARAM " + prefix +
+                                       name + " = " + param.token + " " + why +
+                                       ": read as radians (" + Degrees(param.value) +
+                                       " degrees), not degrees");
+  };
+  const auto name_of = [&](const GeometryParam& param, const std::string& name) {
+    return "PARAM " + prefix + name + " = " + param.token + " (line " + std::to_string(param.line) +
+           ")";
+  };
+  const double n = static_cast<double>(beams);
+  std::optional<double> fov_rad;
+  if (params.fov) {
+    if (params.fov->value <= 2.0 * M_PI) {
+      fov_rad = params.fov->value;
+      note(*params.fov, "fov", "is at most 2 pi");
+    } else {
+      fov_rad = params.fov->value * M_PI / 180.0;
+    }
+  }
+  if (!params.resolution) return fov_rad.value_or(M_PI);  // 180 degrees when nothing is given
+  const GeometryParam& resolution = *params.resolution;
+  const double as_degrees_rad = resolution.value * M_PI / 180.0;
+  const double as_radians_rad = resolution.value;
+  if (fov_rad) {
+    if (beams < 2 || GeometryAgrees(*fov_rad, as_degrees_rad, beams)) return *fov_rad;
+    if (GeometryAgrees(*fov_rad, as_radians_rad, beams)) {
+      note(resolution, "resolution",
+           "agrees with the field of view and beam count only in radians");
+      return *fov_rad;
+    }
+    fields.Fail(name_of(*params.fov, "fov") + " and " + name_of(resolution, "resolution") +
+                " disagree with this line's " + std::to_string(beams) +
+                " beams: " + DisagreementText(*fov_rad, as_degrees_rad, beams));
+  }
+  // No field of view: the beams span n steps of the resolution (FLIRTLib's spreading).
+  const double implied_deg = n * resolution.value;
+  if (beams >= 2 && implied_deg <= 2.0 * M_PI) {
+    note(resolution, "resolution",
+         "gives " + std::to_string(beams) + " beams a field of view of at most 2 pi");
+    return n * as_radians_rad;
+  }
+  if (implied_deg > 360.0 + 0.5 * resolution.value) {
+    fields.Fail(name_of(resolution, "resolution") + " gives this line's " + std::to_string(beams) +
+                " beams a field of view of " + Degrees(n * as_degrees_rad) +
+                " degrees, more than a full turn");
+  }
+  return n * as_degrees_rad;
 }
 
 // FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
@@ -405,11 +521,9 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   // FLASER carries no angular geometry: take the field of view from PARAM when the log gives it,
   // else 180 degrees, and spread the beams as FLIRTLib does (start -fov/2, step fov/n).
   const std::string prefix = front ? "laser_front_laser_" : "laser_rear_laser_";
-  const double resolution_deg = ParamDegrees(state.log, prefix + "resolution", 0.0);
-  double fov_deg = ParamDegrees(state.log, prefix + "fov", 0.0);
-  if (fov_deg <= 0.0)
-    fov_deg = resolution_deg > 0.0 ? resolution_deg * static_cast<double>(n) : 180.0;
-  const double fov_rad = fov_deg * M_PI / 180.0;
+  std::vector<std::pair<std::size_t, std::string>> notes;
+  const double fov_rad = FlaserFieldOfView(
+      fields, state.log.path, front ? state.front_laser : state.rear_laser, prefix, n, notes);
   const double step_rad = n > 0 ? fov_rad / static_cast<double>(n) : 0.0;
   scan.ranges_m.resize(n);
   scan.angles_rad.resize(n);
@@ -428,6 +542,12 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   scan.timestamp_s = fields.Number(p + 6, "ipc_timestamp");
   scan.logger_timestamp_s = fields.Number(p + 8, "logger_timestamp");
   ClassifyBeams(scan, state.log);
+  // Only an accepted line notes how it read a PARAM, once per PARAM line.
+  for (auto& [param_line, text] : notes) {
+    if (state.noted_param_lines.insert(param_line).second) {
+      state.log.warnings.push_back(std::move(text));
+    }
+  }
   return scan;
 }
 
@@ -438,10 +558,16 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
                        "name type start_angle fov resolution max_range accuracy "
                        "remission_mode n ...");
   const double start_rad = fields.Angle(2, "start_angle");
-  fields.Angle(3, "fov");  // not used (the beams are start + i * resolution), but checked
+  // Not used (the beams are start + i * resolution), but checked against resolution and count.
+  const double fov_rad = fields.Angle(3, "fov");
   const double resolution_rad = fields.Angle(4, "angular_resolution");
   const double max_range_m = fields.Number(5, "max_range");
   const std::size_t n = fields.BeamCount(8, "n (beam count)");
+  if (n >= 2 && !GeometryAgrees(fov_rad, resolution_rad, n)) {
+    fields.Fail("fields 'fov' = " + fields.Token(3) + " rad, 'angular_resolution' = " +
+                fields.Token(4) + " rad and 'n' = " + fields.Token(8) +
+                " disagree: " + DisagreementText(fov_rad, resolution_rad, n));
+  }
   fields.ExpectAtLeast(10 + n, "9 header fields, " + std::to_string(n) + " ranges, m ...");
   const std::size_t m = fields.BeamCount(9 + n, "m (remission count)");
   fields.ExpectFieldCount(n + m + 24, "9 header fields, " + std::to_string(n) + " ranges, m, " +
@@ -504,7 +630,8 @@ void ParseLine(const std::string& path, std::size_t line_number,
     log.odometry.push_back(odom);
   } else if (type == "PARAM") {
     fields.ExpectAtLeast(3, "PARAM name value ...");
-    CheckLaserGeometryParam(fields);
+    const auto geometry = LaserGeometryParam(fields, line_number);
+    if (geometry) RecordLaserGeometryParam(geometry->first, geometry->second, state);
     log.params[fields.Token(1)] = fields.Token(2);
   } else if (type == "VERTEX2") {
     fields.ExpectFieldCount(5, "VERTEX2 id x y theta");
