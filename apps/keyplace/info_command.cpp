@@ -44,6 +44,8 @@ double PathLength(const CarmenLog& log) {
 nlohmann::json DescribeLog(const CarmenLog& log) {
   nlohmann::json json;
   json["file"] = log.path;
+  json["file_bytes"] = log.file_bytes;
+  json["fingerprint"] = log.fingerprint;
   json["lines"] = log.lines;
   json["scans"] = log.scans.size();
   json["pose_kind"] = log.corrected ? "corrected" : "odometry";
@@ -122,7 +124,11 @@ void PrintLog(const nlohmann::json& json) {
   }
 }
 
+// Only a regular file is sniffed: reading the first bytes of a pipe would take them from the log
+// reader (`info <(zcat log.gz)` lost its first scans). The log reader refuses an SQLite stream.
 bool IsSqliteFile(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return false;
   char header[16] = {};
   std::ifstream in(path, std::ios::binary);
   in.read(header, sizeof(header));

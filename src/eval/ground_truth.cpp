@@ -24,9 +24,15 @@ GroundTruth TruthFromOwnPoses(const CarmenLog& log, std::size_t first_scan,
   }
   GroundTruth truth;
   truth.truth_log = log.path;
-  // A log built in memory (no path) has no file to fingerprint.
-  truth.truth_log_hash =
-      !log_hash.empty() || log.path.empty() ? log_hash : FileFingerprint(log.path);
+  // The reader's fingerprint first: a log read from a pipe cannot be read again. A log built in
+  // memory (no path) has no file to fingerprint.
+  if (!log_hash.empty()) {
+    truth.truth_log_hash = log_hash;
+  } else if (!log.fingerprint.empty()) {
+    truth.truth_log_hash = log.fingerprint;
+  } else if (!log.path.empty()) {
+    truth.truth_log_hash = FileFingerprint(log.path);
+  }
   truth.truth_first_scan = first_scan;
   for (std::size_t k = 0; k < log.scans.size(); ++k) {
     const LogScan& scan = log.scans[k];

@@ -1,29 +1,60 @@
 #include "keyplace/io/carmen_log.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
+#include <array>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "io/file_fingerprint.hpp"
+
 namespace keyplace {
 namespace {
 
-// Reads a plain or gzip-compressed text file line by line (zlib reads plain files as they are).
+// Reads a plain or gzip-compressed text file line by line, once, front to back: the input may be a
+// pipe or a FIFO (`keyplace info <(zcat log.gz)`), which can be neither reopened nor rewound, so
+// the format is decided from bytes already read and the fingerprint (CRC32 and size of every
+// byte, as FileFingerprint) is taken on the way instead of by a second read.
 class LineReader {
  public:
-  explicit LineReader(const std::string& path) : path_(path), file_(gzopen(path.c_str(), "rb")) {
-    if (file_ == nullptr) throw std::runtime_error(path + ": cannot open file");
-    gzbuffer(file_, 1 << 17);
+  explicit LineReader(const std::string& path) : path_(path), raw_(kBufferBytes) {
+    file_.fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (file_.fd < 0) {
+      throw std::runtime_error(path + ": cannot open file (" + std::strerror(errno) + ")");
+    }
+    struct stat status {};
+    if (fstat(file_.fd, &status) == 0 && S_ISDIR(status.st_mode)) {
+      throw std::runtime_error(path + ": is a directory, not a log file");
+    }
+    regular_ = S_ISREG(status.st_mode);
+    // A pipe may deliver fewer bytes per read than the magic numbers need.
+    EnsureRaw(kSqliteMagic.size());
+    if (raw_end_ >= kSqliteMagic.size() &&
+        std::memcmp(raw_.data(), kSqliteMagic.data(), kSqliteMagic.size()) == 0) {
+      throw std::invalid_argument(
+          path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
+          (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
+    }
+    gzip_ = StartsWithGzipMagic();
+    if (gzip_) StartInflating();
   }
   ~LineReader() {
-    if (file_ != nullptr) gzclose(file_);
+    if (inflating_) inflateEnd(&stream_);
   }
   LineReader(const LineReader&) = delete;
   LineReader& operator=(const LineReader&) = delete;
@@ -31,19 +62,22 @@ class LineReader {
   // Next line without its end-of-line characters; false at the end of the file.
   bool Next(std::string& line) {
     line.clear();
-    char chunk[1 << 14];
-    while (gzgets(file_, chunk, sizeof(chunk)) != nullptr) {
-      line.append(chunk);
-      if (!line.empty() && line.back() == '\n') break;
+    terminated_ = false;
+    while (true) {
+      if (text_begin_ == text_end_ && !FillText()) break;
+      const char* begin = text_ + text_begin_;
+      const auto* newline =
+          static_cast<const char*>(std::memchr(begin, '\n', text_end_ - text_begin_));
+      const std::size_t take = newline != nullptr ? static_cast<std::size_t>(newline - begin) + 1
+                                                  : text_end_ - text_begin_;
+      line.append(begin, take);
+      text_begin_ += take;
+      if (newline != nullptr) {
+        terminated_ = true;
+        break;
+      }
     }
-    terminated_ = !line.empty() && line.back() == '\n';
-    int error_code = Z_OK;
-    const char* message = gzerror(file_, &error_code);
-    if (error_code != Z_OK && error_code != Z_STREAM_END) {
-      throw std::runtime_error(path_ + ": truncated or corrupt compressed data after line " +
-                               std::to_string(line_number_) + " (" + message + ")");
-    }
-    if (line.empty() && gzeof(file_)) return false;
+    if (line.empty()) return false;
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     ++line_number_;
     return true;
@@ -53,9 +87,141 @@ class LineReader {
   // Whether the latest line ended with an end of line (only the file's last line may not).
   bool terminated() const { return terminated_; }
 
+  // Reads what follows the last line (bytes after the compressed data) so that the fingerprint
+  // covers the whole input, then FormatFingerprint of it.
+  std::string Fingerprint() {
+    raw_begin_ = raw_end_ = 0;
+    while (ReadRaw(0) > 0) raw_end_ = 0;
+    return FormatFingerprint(static_cast<std::uint32_t>(crc_), bytes_);
+  }
+  std::uint64_t bytes() const { return bytes_; }
+
  private:
+  static constexpr std::size_t kBufferBytes = 1 << 17;
+  static constexpr std::array<char, 16> kSqliteMagic = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f',
+                                                        'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
+
+  // Appends up to the free space of raw_ after `at` from the input; 0 at its end.
+  std::size_t ReadRaw(std::size_t at) {
+    if (eof_) return 0;
+    while (true) {
+      const ssize_t got = read(file_.fd, raw_.data() + at, raw_.size() - at);
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) {
+        throw std::runtime_error(path_ + ": read error after line " + std::to_string(line_number_) +
+                                 " (" + std::strerror(errno) + ")");
+      }
+      if (got == 0) eof_ = true;
+      const auto count = static_cast<std::size_t>(got);
+      crc_ = crc32(crc_, raw_.data() + at, static_cast<uInt>(count));
+      bytes_ += count;
+      raw_end_ = at + count;
+      return count;
+    }
+  }
+
+  // At least `count` unread raw bytes at raw_begin_, unless the input ends first.
+  void EnsureRaw(std::size_t count) {
+    if (raw_begin_ > 0) {
+      std::memmove(raw_.data(), raw_.data() + raw_begin_, raw_end_ - raw_begin_);
+      raw_end_ -= raw_begin_;
+      raw_begin_ = 0;
+    }
+    while (raw_end_ < count && ReadRaw(raw_end_) > 0) {
+    }
+  }
+
+  bool StartsWithGzipMagic() const {
+    return raw_end_ - raw_begin_ >= 2 && raw_[raw_begin_] == 0x1f && raw_[raw_begin_ + 1] == 0x8b;
+  }
+
+  void StartInflating() {
+    stream_ = z_stream{};
+    // 15 + 16: a gzip wrapper only (a plain file is read as it is, as zlib's gzread does).
+    if (inflateInit2(&stream_, 15 + 16) != Z_OK) {
+      throw std::runtime_error(path_ + ": cannot start gzip decompression");
+    }
+    inflating_ = true;
+  }
+
+  [[noreturn]] void FailCompressed(const std::string& why) const {
+    throw std::runtime_error(path_ + ": truncated or corrupt compressed data after line " +
+                             std::to_string(line_number_) + " (" + why + ")");
+  }
+
+  // Makes more text available in text_[text_begin_, text_end_); false at the end of the input.
+  bool FillText() {
+    if (!gzip_) {
+      if (raw_begin_ == raw_end_ && ReadRaw(0) == 0) return false;
+      text_ = reinterpret_cast<const char*>(raw_.data());
+      text_begin_ = raw_begin_;
+      text_end_ = raw_end_;
+      raw_begin_ = raw_end_ = 0;
+      return true;
+    }
+    if (text_buffer_.empty()) text_buffer_.resize(kBufferBytes);
+    while (true) {
+      if (member_ended_) {
+        // gzip members may be concatenated; anything else after one is ignored, as gzread does.
+        EnsureRaw(2);
+        if (!StartsWithGzipMagic()) return false;
+        inflateReset(&stream_);
+        member_ended_ = false;
+      }
+      if (raw_begin_ == raw_end_) {
+        raw_begin_ = 0;
+        if (ReadRaw(0) == 0) FailCompressed("unexpected end of file");
+      }
+      stream_.next_in = raw_.data() + raw_begin_;
+      stream_.avail_in = static_cast<uInt>(raw_end_ - raw_begin_);
+      stream_.next_out = reinterpret_cast<Bytef*>(text_buffer_.data());
+      stream_.avail_out = static_cast<uInt>(text_buffer_.size());
+      const int result = inflate(&stream_, Z_NO_FLUSH);
+      raw_begin_ = raw_end_ - stream_.avail_in;
+      if (result == Z_STREAM_END) {
+        member_ended_ = true;
+      } else if (result != Z_OK && result != Z_BUF_ERROR) {
+        FailCompressed(stream_.msg != nullptr ? stream_.msg
+                                              : "zlib error " + std::to_string(result));
+      }
+      const std::size_t produced = text_buffer_.size() - stream_.avail_out;
+      if (produced > 0) {
+        text_ = text_buffer_.data();
+        text_begin_ = 0;
+        text_end_ = produced;
+        return true;
+      }
+    }
+  }
+
+  // Closed however the constructor or the reading ends.
+  struct FileDescriptor {
+    int fd = -1;
+    FileDescriptor() = default;
+    FileDescriptor(const FileDescriptor&) = delete;
+    FileDescriptor& operator=(const FileDescriptor&) = delete;
+    ~FileDescriptor() {
+      if (fd >= 0) close(fd);
+    }
+  };
+
   std::string path_;
-  gzFile file_;
+  FileDescriptor file_;
+  bool regular_ = false;
+  bool eof_ = false;
+  std::vector<unsigned char> raw_;  // bytes as read from the input
+  std::size_t raw_begin_ = 0;
+  std::size_t raw_end_ = 0;
+  uLong crc_ = crc32(0L, Z_NULL, 0);
+  std::uint64_t bytes_ = 0;
+  bool gzip_ = false;
+  bool inflating_ = false;
+  bool member_ended_ = false;
+  z_stream stream_{};
+  std::vector<char> text_buffer_;  // decompressed text (gzip input)
+  const char* text_ = nullptr;     // where the unread text lies: raw_ or text_buffer_
+  std::size_t text_begin_ = 0;
+  std::size_t text_end_ = 0;
   std::size_t line_number_ = 0;
   bool terminated_ = true;
 };
@@ -178,9 +344,25 @@ class FieldParser {
   double max_coordinate_m_;
 };
 
+// A PARAM laser_{front,rear}_laser_{fov,resolution} in effect: its number (degrees expected) and
+// the line that set it, for notes and errors.
+struct GeometryParam {
+  double value = 0.0;
+  std::string token;
+  std::size_t line = 0;
+};
+
+struct LaserParams {
+  std::optional<GeometryParam> fov;
+  std::optional<GeometryParam> resolution;
+};
+
 struct ReaderState {
   CarmenLog log;
   CarmenReadOptions options;
+  LaserParams front_laser;
+  LaserParams rear_laser;
+  std::set<std::size_t> noted_param_lines;  // PARAM lines whose reading was already noted
   bool in_loop_edges = false;
   bool saw_corrected_marker = false;
 };
@@ -200,31 +382,129 @@ void ClassifyBeams(LaserScan& scan, CarmenLog& log) {
   }
 }
 
-// The PARAMs that give FLASER/RLASER lines their angles (ParamDegrees): a number there must be
-// a finite angle in (0, 360] degrees (an infinite field of view made every beam angle NaN). A
-// value that is no number, zero or negative keeps being ignored (the defaults apply).
-void CheckLaserGeometryParam(const FieldParser& fields) {
+// The PARAMs that give FLASER/RLASER lines their angles: a number there must be a finite angle
+// in (0, 360] degrees (an infinite field of view made every beam angle NaN). A value that is no
+// number, zero or negative keeps being ignored (the defaults apply). Returns the PARAM's laser and
+// value when it is one of them, to be recorded once the line is accepted.
+std::optional<std::pair<GeometryParam, std::string>> LaserGeometryParam(const FieldParser& fields,
+                                                                        std::size_t line) {
   const std::string name = fields.Token(1);
   if (name != "laser_front_laser_fov" && name != "laser_front_laser_resolution" &&
       name != "laser_rear_laser_fov" && name != "laser_rear_laser_resolution") {
-    return;
+    return std::nullopt;
   }
-  const std::string token = fields.Token(2);
-  double value = 0.0;
-  const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (result.ec != std::errc() || !(value > 0.0)) return;
-  if (!(value <= 360.0)) {
-    fields.Fail(name + " = '" + token + "' is not an angle in (0, 360] degrees");
+  GeometryParam param;
+  param.token = fields.Token(2);
+  param.line = line;
+  const auto result =
+      std::from_chars(param.token.data(), param.token.data() + param.token.size(), param.value);
+  if (result.ec != std::errc() || !(param.value > 0.0)) param.value = 0.0;  // ignored
+  if (!(param.value <= 360.0)) {
+    fields.Fail(name + " = '" + param.token + "' is not an angle in (0, 360] degrees");
+  }
+  return std::make_pair(param, name);
+}
+
+void RecordLaserGeometryParam(const GeometryParam& param, const std::string& name,
+                              ReaderState& state) {
+  LaserParams& laser = name.rfind("laser_front_", 0) == 0 ? state.front_laser : state.rear_laser;
+  std::optional<GeometryParam>& slot =
+      name.size() >= 4 && name.compare(name.size() - 4, 4, "_fov") == 0 ? laser.fov
+                                                                        : laser.resolution;
+  if (param.value > 0.0) {
+    slot = param;
+  } else {
+    slot.reset();
   }
 }
 
-double ParamDegrees(const CarmenLog& log, const std::string& name, double fallback_deg) {
-  const auto it = log.params.find(name);
-  if (it == log.params.end()) return fallback_deg;
-  double value = 0.0;
-  const auto result =
-      std::from_chars(it->second.data(), it->second.data() + it->second.size(), value);
-  return result.ec == std::errc() && value > 0.0 ? value : fallback_deg;
+// Whether a field of view, an angular resolution and a beam count describe one scan. Two
+// conventions are in use: the field of view spans n steps (each beam owns a sector of one
+// resolution: CARMEN's writer, FLIRTLib, and this reader, which spreads FLASER beams from -fov/2
+// in steps of fov/n) or n-1 steps (first to last beam, as a ROS LaserScan's angle_max -
+// angle_min). Both are accepted, widened by half a step (a field of view rounded to the nearest
+// step, whole degrees) and 1 % of the field of view (resolutions written with three significant
+// digits, 0.333 for 1/3 degree, are 0.1 % off; six-decimal radians over 8192 beams 0.07 %). The
+// contradictions that corrupt the geometry are far outside: degrees read as radians are 57x off,
+// a halved resolution or a doubled beam count 2x.
+bool GeometryAgrees(double fov_rad, double resolution_rad, std::size_t beams) {
+  const double step_rad = std::abs(resolution_rad);
+  const double tolerance_rad = 0.5 * step_rad + 0.01 * std::abs(fov_rad);
+  const double n = static_cast<double>(beams);
+  return fov_rad >= (n - 1.0) * step_rad - tolerance_rad && fov_rad <= n * step_rad + tolerance_rad;
+}
+
+std::string Degrees(double angle_rad) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4g", angle_rad * 180.0 / M_PI);
+  return text;
+}
+
+std::string DisagreementText(double fov_rad, double resolution_rad, std::size_t beams) {
+  char steps[32];
+  std::snprintf(steps, sizeof(steps), "%.4g", fov_rad / std::abs(resolution_rad));
+  return "a field of view of " + Degrees(fov_rad) + " degrees spans " + steps +
+         " steps of the resolution " + Degrees(resolution_rad) + " degrees, but " +
+         std::to_string(beams) + " beams need " + std::to_string(beams - 1) + " or " +
+         std::to_string(beams) + " (within half a step + 1 %)";
+}
+
+// The field of view of a FLASER/RLASER line with `beams` beams from the PARAMs in effect, which
+// are checked against each other and the beam count, not trusted. A value at most 2 pi where
+// degrees are expected is a field of view in radians (no 2D lidar sees less than 6.3 degrees):
+// it is read so, with a note. `notes` gets one sentence per PARAM line read as radians.
+double FlaserFieldOfView(const FieldParser& fields, const std::string& path,
+                         const LaserParams& params, const std::string& prefix, std::size_t beams,
+                         std::vector<std::pair<std::size_t, std::string>>& notes) {
+  const auto note = [&](const GeometryParam& param, const std::string& name,
+                        const std::string& why) {
+    notes.emplace_back(param.line, path + ":" + std::to_string(param.line) + ": PARAM " + prefix +
+                                       name + " = " + param.token + " " + why +
+                                       ": read as radians (" + Degrees(param.value) +
+                                       " degrees), not degrees");
+  };
+  const auto name_of = [&](const GeometryParam& param, const std::string& name) {
+    return "PARAM " + prefix + name + " = " + param.token + " (line " + std::to_string(param.line) +
+           ")";
+  };
+  const double n = static_cast<double>(beams);
+  std::optional<double> fov_rad;
+  if (params.fov) {
+    if (params.fov->value <= 2.0 * M_PI) {
+      fov_rad = params.fov->value;
+      note(*params.fov, "fov", "is at most 2 pi");
+    } else {
+      fov_rad = params.fov->value * M_PI / 180.0;
+    }
+  }
+  if (!params.resolution) return fov_rad.value_or(M_PI);  // 180 degrees when nothing is given
+  const GeometryParam& resolution = *params.resolution;
+  const double as_degrees_rad = resolution.value * M_PI / 180.0;
+  const double as_radians_rad = resolution.value;
+  if (fov_rad) {
+    if (beams < 2 || GeometryAgrees(*fov_rad, as_degrees_rad, beams)) return *fov_rad;
+    if (GeometryAgrees(*fov_rad, as_radians_rad, beams)) {
+      note(resolution, "resolution",
+           "agrees with the field of view and beam count only in radians");
+      return *fov_rad;
+    }
+    fields.Fail(name_of(*params.fov, "fov") + " and " + name_of(resolution, "resolution") +
+                " disagree with this line's " + std::to_string(beams) +
+                " beams: " + DisagreementText(*fov_rad, as_degrees_rad, beams));
+  }
+  // No field of view: the beams span n steps of the resolution (FLIRTLib's spreading).
+  const double implied_deg = n * resolution.value;
+  if (beams >= 2 && implied_deg <= 2.0 * M_PI) {
+    note(resolution, "resolution",
+         "gives " + std::to_string(beams) + " beams a field of view of at most 2 pi");
+    return n * as_radians_rad;
+  }
+  if (implied_deg > 360.0 + 0.5 * resolution.value) {
+    fields.Fail(name_of(resolution, "resolution") + " gives this line's " + std::to_string(beams) +
+                " beams a field of view of " + Degrees(n * as_degrees_rad) +
+                " degrees, more than a full turn");
+  }
+  return n * as_degrees_rad;
 }
 
 // FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
@@ -241,11 +521,9 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   // FLASER carries no angular geometry: take the field of view from PARAM when the log gives it,
   // else 180 degrees, and spread the beams as FLIRTLib does (start -fov/2, step fov/n).
   const std::string prefix = front ? "laser_front_laser_" : "laser_rear_laser_";
-  const double resolution_deg = ParamDegrees(state.log, prefix + "resolution", 0.0);
-  double fov_deg = ParamDegrees(state.log, prefix + "fov", 0.0);
-  if (fov_deg <= 0.0)
-    fov_deg = resolution_deg > 0.0 ? resolution_deg * static_cast<double>(n) : 180.0;
-  const double fov_rad = fov_deg * M_PI / 180.0;
+  std::vector<std::pair<std::size_t, std::string>> notes;
+  const double fov_rad = FlaserFieldOfView(
+      fields, state.log.path, front ? state.front_laser : state.rear_laser, prefix, n, notes);
   const double step_rad = n > 0 ? fov_rad / static_cast<double>(n) : 0.0;
   scan.ranges_m.resize(n);
   scan.angles_rad.resize(n);
@@ -264,6 +542,12 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   scan.timestamp_s = fields.Number(p + 6, "ipc_timestamp");
   scan.logger_timestamp_s = fields.Number(p + 8, "logger_timestamp");
   ClassifyBeams(scan, state.log);
+  // Only an accepted line notes how it read a PARAM, once per PARAM line.
+  for (auto& [param_line, text] : notes) {
+    if (state.noted_param_lines.insert(param_line).second) {
+      state.log.warnings.push_back(std::move(text));
+    }
+  }
   return scan;
 }
 
@@ -274,10 +558,16 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
                        "name type start_angle fov resolution max_range accuracy "
                        "remission_mode n ...");
   const double start_rad = fields.Angle(2, "start_angle");
-  fields.Angle(3, "fov");  // not used (the beams are start + i * resolution), but checked
+  // Not used (the beams are start + i * resolution), but checked against resolution and count.
+  const double fov_rad = fields.Angle(3, "fov");
   const double resolution_rad = fields.Angle(4, "angular_resolution");
   const double max_range_m = fields.Number(5, "max_range");
   const std::size_t n = fields.BeamCount(8, "n (beam count)");
+  if (n >= 2 && !GeometryAgrees(fov_rad, resolution_rad, n)) {
+    fields.Fail("fields 'fov' = " + fields.Token(3) + " rad, 'angular_resolution' = " +
+                fields.Token(4) + " rad and 'n' = " + fields.Token(8) +
+                " disagree: " + DisagreementText(fov_rad, resolution_rad, n));
+  }
   fields.ExpectAtLeast(10 + n, "9 header fields, " + std::to_string(n) + " ranges, m ...");
   const std::size_t m = fields.BeamCount(9 + n, "m (remission count)");
   fields.ExpectFieldCount(n + m + 24, "9 header fields, " + std::to_string(n) + " ranges, m, " +
@@ -340,7 +630,8 @@ void ParseLine(const std::string& path, std::size_t line_number,
     log.odometry.push_back(odom);
   } else if (type == "PARAM") {
     fields.ExpectAtLeast(3, "PARAM name value ...");
-    CheckLaserGeometryParam(fields);
+    const auto geometry = LaserGeometryParam(fields, line_number);
+    if (geometry) RecordLaserGeometryParam(geometry->first, geometry->second, state);
     log.params[fields.Token(1)] = fields.Token(2);
   } else if (type == "VERTEX2") {
     fields.ExpectFieldCount(5, "VERTEX2 id x y theta");
@@ -427,6 +718,8 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
                            " (line " + numbers + "); the first: " + first_skipped_error);
   }
   log.lines = reader.line_number();
+  log.fingerprint = reader.Fingerprint();
+  log.file_bytes = reader.bytes();
   switch (options.pose_kind) {
     case CarmenReadOptions::PoseKind::kCorrected:
       log.corrected = true;

@@ -8,8 +8,6 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "io/file_fingerprint.hpp"
-
 namespace keyplace {
 
 PoseSource ParsePoseSource(const std::string& text) {
@@ -100,7 +98,7 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
   }
   inputs.first_scan = begin;
   inputs.source_log = std::filesystem::path(path).filename().string();
-  inputs.source_hash = FileFingerprint(path);
+  inputs.source_hash = inputs.log.fingerprint;  // the log is read once: it may be a pipe
   inputs.seconds_read = SecondsSince(start);
 
   start = std::chrono::steady_clock::now();

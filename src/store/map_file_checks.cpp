@@ -125,8 +125,14 @@ bool IsMapTable(const std::string& name) {
 // file from reaching SQLite, and files in write-ahead-log mode from creating -wal / -shm files.
 MapFileFacts CheckMapFileHeader(const std::string& path) {
   std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    throw std::runtime_error(path + ": map file not found");
+  }
+  // SQLite seeks through the file, and the checks read it more than once: a pipe cannot do that.
   if (!std::filesystem::is_regular_file(path, error)) {
-    throw std::runtime_error(path + ": map file not found (or not a regular file)");
+    throw std::runtime_error(path +
+                             ": map files must be regular files (not a pipe, FIFO or device); "
+                             "copy it to a file first");
   }
   MapFileFacts facts;
   facts.bytes = std::filesystem::file_size(path, error);

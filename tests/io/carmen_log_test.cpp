@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -196,7 +197,122 @@ TEST(CarmenLog, NonFiniteOrAbsurdFieldOfViewIsAnErrorNamingTheLine) {
   ExpectError<std::invalid_argument>(fov_inf, {fov_inf + ":1", "'fov'"});
   const std::string res_huge = WriteText("rl_res.log", with("3.14", "1e300"));
   ExpectError<std::invalid_argument>(res_huge, {res_huge + ":1", "'angular_resolution'"});
-  EXPECT_EQ(ReadCarmenLog(WriteText("rl_ok.log", with("3.14", "0.01"))).scans.size(), 1u);
+  EXPECT_EQ(ReadCarmenLog(WriteText("rl_ok.log", with("0.02", "0.01"))).scans.size(), 1u);
+}
+
+TEST(CarmenLog, FieldOfViewInRadiansWhereDegreesAreExpectedIsReadAsRadiansWithANote) {
+  // Formerly read as 3.1 degrees, silently (issue 18).
+  const std::string path =
+      WriteText("fov_rad.log", "PARAM laser_front_laser_fov 3.14159 nohost 0\n" +
+                                   Flaser(10, "1.0", "0 0 0 0 0 0 1 h 1") +
+                                   Flaser(10, "1.0", "0 0 0 0 0 0 2 h 2"));
+  const CarmenLog log = ReadCarmenLog(path);
+  ASSERT_EQ(log.scans.size(), 2u);
+  EXPECT_NEAR(log.scans[0].angles_rad[0], -0.5 * 3.14159, 1e-12);
+  EXPECT_NEAR(log.scans[0].angles_rad[1] - log.scans[0].angles_rad[0], 0.314159, 1e-12);
+  ASSERT_EQ(log.warnings.size(), 1u);  // one note per PARAM line, not one per scan
+  for (const std::string& fragment : std::initializer_list<std::string>{
+           path + ":1", "laser_front_laser_fov", "3.14159", "radians", "180 degrees"}) {
+    EXPECT_NE(log.warnings[0].find(fragment), std::string::npos) << log.warnings[0];
+  }
+  // In degrees: no note.
+  const std::string degrees =
+      WriteText("fov_deg.log", "PARAM laser_front_laser_fov 180 nohost 0\n" +
+                                   Flaser(10, "1.0", "0 0 0 0 0 0 1 h 1"));
+  EXPECT_TRUE(ReadCarmenLog(degrees).warnings.empty());
+}
+
+TEST(CarmenLog, FieldOfViewResolutionAndBeamCountMustAgree) {
+  const auto log_with = [](const std::string& name, const std::string& fov,
+                           const std::string& resolution, int beams) {
+    return WriteText(name, "PARAM laser_front_laser_fov " + fov + " nohost 0\n" +
+                               "PARAM laser_front_laser_resolution " + resolution + " nohost 0\n" +
+                               Flaser(beams, "1.0", "0 0 0 0 0 0 1 h 1"));
+  };
+  // Both conventions: n steps (CARMEN, FLIRTLib) and n - 1 steps (first to last beam).
+  for (const auto& [fov, resolution, beams] :
+       {std::make_tuple("180", "1", 180), std::make_tuple("180", "1", 181),
+        std::make_tuple("180", "0.5", 360), std::make_tuple("270", "0.25", 1081),
+        std::make_tuple("100", "0.333", 301)}) {
+    const std::string path = log_with(
+        std::string("agree_") + fov + "_" + std::to_string(beams) + ".log", fov, resolution, beams);
+    const CarmenLog log = ReadCarmenLog(path);
+    ASSERT_EQ(log.scans.size(), 1u) << path;
+    EXPECT_TRUE(log.warnings.empty()) << path;
+    // The field of view decides the angles, spread as FLIRTLib does.
+    EXPECT_NEAR(log.scans[0].angles_rad[0], -0.5 * std::stod(fov) * M_PI / 180.0, 1e-12);
+  }
+  // Half the beams, ten beams too many (1 % + half a step is 2.3 here), a resolution twice too
+  // fine.
+  for (const auto& [fov, resolution, beams] :
+       {std::make_tuple("180", "1", 90), std::make_tuple("180", "1", 190),
+        std::make_tuple("180", "0.25", 360)}) {
+    const std::string path =
+        log_with(std::string("disagree_") + resolution + "_" + std::to_string(beams) + ".log", fov,
+                 resolution, beams);
+    ExpectError<std::invalid_argument>(
+        path, {path + ":3: FLASER", "laser_front_laser_fov = 180 (line 1)",
+               std::string("laser_front_laser_resolution = ") + resolution + " (line 2)",
+               std::to_string(beams) + " beams", "disagree"});
+  }
+  // A resolution alone that spans more than a full turn.
+  const std::string turn = WriteText("turn.log", "PARAM laser_front_laser_resolution 2 nohost 0\n" +
+                                                     Flaser(360, "1", "0 0 0 0 0 0 1 h 1"));
+  ExpectError<std::invalid_argument>(turn, {turn + ":2: FLASER", "resolution = 2 (line 1)",
+                                            "720 degrees", "more than a full turn"});
+}
+
+TEST(CarmenLog, ResolutionInRadiansIsReadAsRadiansWithANote) {
+  // Beside a field of view in degrees, only radians agree with the beam count.
+  const std::string with_fov = WriteText("res_rad.log",
+                                         "PARAM laser_front_laser_fov 180 nohost 0\n"
+                                         "PARAM laser_front_laser_resolution 0.008727 nohost 0\n" +
+                                             Flaser(360, "1", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog log = ReadCarmenLog(with_fov);
+  ASSERT_EQ(log.warnings.size(), 1u);
+  EXPECT_NE(log.warnings[0].find(with_fov + ":2: PARAM laser_front_laser_resolution = 0.008727"),
+            std::string::npos)
+      << log.warnings[0];
+  EXPECT_NEAR(log.scans[0].angles_rad[0], -M_PI / 2.0, 1e-12);
+  // Alone: 180 beams at 0.0174533 "degrees" would see 3.1 degrees.
+  const std::string alone =
+      WriteText("res_rad_alone.log", "PARAM laser_front_laser_resolution 0.0174533 nohost 0\n" +
+                                         Flaser(180, "1", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog alone_log = ReadCarmenLog(alone);
+  ASSERT_EQ(alone_log.warnings.size(), 1u);
+  EXPECT_NE(alone_log.warnings[0].find(alone + ":1: PARAM laser_front_laser_resolution"),
+            std::string::npos);
+  EXPECT_NEAR(alone_log.scans[0].angles_rad[0], -0.5 * 180 * 0.0174533, 1e-12);
+  // In degrees, as expected: 180 beams at 1 degree, no note.
+  const std::string degrees =
+      WriteText("res_deg.log", "PARAM laser_front_laser_resolution 1 nohost 0\n" +
+                                   Flaser(180, "1", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog degrees_log = ReadCarmenLog(degrees);
+  EXPECT_TRUE(degrees_log.warnings.empty());
+  EXPECT_NEAR(degrees_log.scans[0].angles_rad[0], -M_PI / 2.0, 1e-12);
+}
+
+TEST(CarmenLog, RobotLaserFieldOfViewResolutionAndBeamCountMustAgree) {
+  const auto line = [](const std::string& fov, const std::string& resolution, int beams) {
+    std::string text = "ROBOTLASER1 0 -1.570796 " + fov + " " + resolution + " 50.0 0.1 0 " +
+                       std::to_string(beams);
+    for (int i = 0; i < beams; ++i) text += " 1.5";
+    return text + " 0 0 0 0 0 0 0 0 0 0 0 0 10.5 x 0.0\n";
+  };
+  // FR079's and Intel's headers (n steps), and the n - 1 convention.
+  EXPECT_EQ(ReadCarmenLog(WriteText("fr079.log", line("3.141720", "0.008727", 360))).scans.size(),
+            1u);
+  EXPECT_EQ(ReadCarmenLog(WriteText("intel.log", line("3.141593", "0.017453", 180))).scans.size(),
+            1u);
+  EXPECT_EQ(ReadCarmenLog(WriteText("ros.log", line("3.141593", "0.017453", 181))).scans.size(),
+            1u);
+  // Degrees where radians are expected, and half the beams.
+  const std::string degrees = WriteText("rl_deg.log", line("3.141593", "0.5", 360));
+  ExpectError<std::invalid_argument>(
+      degrees, {degrees + ":1: ROBOTLASER1", "'fov' = 3.141593", "'angular_resolution' = 0.5",
+                "'n' = 360", "disagree"});
+  const std::string half = WriteText("rl_half.log", line("3.141593", "0.017453", 90));
+  ExpectError<std::invalid_argument>(half, {half + ":1: ROBOTLASER1", "'n' = 90", "disagree"});
 }
 
 TEST(CarmenLog, FarCoordinatesAreAnErrorNamingLineAndField) {

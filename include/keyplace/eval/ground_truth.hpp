@@ -46,8 +46,9 @@ struct GroundTruth {
 };
 
 /// The log's own corrected poses; scans[0] of `log` is scan `first_scan` of its file (a range
-/// cut). `log_hash`: FileFingerprint of log.path when the caller has it (LogInputs::source_hash),
-/// else empty and it is computed (left empty for a log without a path). Throws
+/// cut). `log_hash`: the log's fingerprint when the caller has it (LogInputs::source_hash), else
+/// empty and CarmenLog::fingerprint is taken, or for a log built in memory with a path that
+/// file's FileFingerprint (left empty for a log without a path). Throws
 /// std::invalid_argument naming the log when it has no corrected poses.
 GroundTruth TruthFromOwnPoses(const CarmenLog& log, std::size_t first_scan = 0,
                               const std::string& log_hash = "");

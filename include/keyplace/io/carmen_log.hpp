@@ -2,6 +2,7 @@
 // Reader for CARMEN text logs (plain or gzip-compressed).
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -58,6 +59,11 @@ struct CarmenLog {
   std::map<std::string, std::string> params;       // PARAM name -> value
   std::map<std::string, std::size_t> line_counts;  // per message type, plus "#comment", "unknown"
   std::size_t lines = 0;
+  // "crc32:<hex>:<bytes>" of the file's bytes (compressed ones for a .gz), taken while reading:
+  // a pipe cannot be read a second time. Maps record it as source_hash. Empty for a log built
+  // in memory.
+  std::string fingerprint;
+  std::uint64_t file_bytes = 0;     // bytes read from the file (compressed ones for a .gz)
   std::size_t invalid_beams = 0;    // beams marked invalid because of NaN/inf/negative values
   std::size_t no_return_beams = 0;  // beams at or beyond max range (normal "no echo")
   // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
@@ -95,6 +101,8 @@ struct CarmenReadOptions {
 /// input (unless options.skip_bad_lines), std::runtime_error when the file cannot be opened or
 /// its compressed data are truncated. A last line without end of line that does not parse is
 /// dropped with a warning (CarmenLog::warnings): what a logger killed mid-line leaves.
+/// The file is opened once and read once, front to back, so it may be a pipe, a FIFO or
+/// /dev/fd/N; an SQLite file (a map) is an error saying so.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
 /// ReadCarmenLog, and throws std::invalid_argument naming the file when it holds no laser scan

@@ -68,7 +68,7 @@ struct LogInputs {
   std::vector<Pose2> poses;                      // T_world_robot of every scan (if computed)
   std::vector<std::vector<Keypoint>> keypoints;  // laser frame
   std::string source_log;                        // file name of the log
-  std::string source_hash;                       // FileFingerprint of the log
+  std::string source_hash;                       // CarmenLog::fingerprint of the log
   std::size_t first_scan = 0;                    // index in the file of scans[0]
   std::size_t file_scans = 0;                    // scans in the file (before the cut)
   double seconds_read = 0.0;
