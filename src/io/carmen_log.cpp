@@ -70,6 +70,14 @@ class LineReader {
           static_cast<const char*>(std::memchr(begin, '\n', text_end_ - text_begin_));
       const std::size_t take = newline != nullptr ? static_cast<std::size_t>(newline - begin) + 1
                                                   : text_end_ - text_begin_;
+      if (line.size() + take > kMaxLineBytes) {
+        // Before growing: one endless line (a binary file, a damaged log) must not take all memory.
+        throw std::invalid_argument(path_ + ":" + std::to_string(line_number_ + 1) +
+                                    ": line longer than " + std::to_string(kMaxLineBytes >> 20) +
+                                    " MiB, not a CARMEN log line (the longest keyplace reads, " +
+                                    std::to_string(kMaxScanBeams) +
+                                    " ranges and remissions, is under 1 MiB)");
+      }
       line.append(begin, take);
       text_begin_ += take;
       if (newline != nullptr) {
@@ -98,6 +106,8 @@ class LineReader {
 
  private:
   static constexpr std::size_t kBufferBytes = 1 << 17;
+  // 2 x 8192 numbers of up to 24 characters are 0.4 MiB: 4 MiB leaves room for any spelling.
+  static constexpr std::size_t kMaxLineBytes = std::size_t{4} << 20;
   static constexpr std::array<char, 16> kSqliteMagic = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f',
                                                         'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
 

@@ -345,6 +345,21 @@ TEST(CarmenLog, MoreBeamsThanRealLidarsGiveIsAnErrorNamingTheLine) {
   EXPECT_EQ(ReadCarmenLog(most).scans.at(0).size(), kMaxScanBeams);
 }
 
+TEST(CarmenLog, EndlessLineIsAnErrorNamingTheLine) {
+  // Formerly a 2 GiB line was read whole; the reader now stops at 4 MiB.
+  const std::string long_line = "FLASER 1 " + std::string(5u << 20, '7') + " 0 0 0 0 0 0 1 h 1\n";
+  const std::string path = WriteText("endless.log", "# c\n" + long_line);
+  ExpectError<std::invalid_argument>(path, {path + ":2", "line longer than 4 MiB"});
+  // The same without an end of line (the last line of a cut-off log) is no different.
+  const std::string cut = WriteText("endless-cut.log", "# c\n" + long_line.substr(0, 5u << 20));
+  ExpectError<std::invalid_argument>(cut, {cut + ":2", "line longer than 4 MiB"});
+  // A line just under the bound is read (and rejected for what it says, not for its length).
+  const std::string under =
+      WriteText("under.log", "# " + std::string((std::size_t{4} << 20) - 16, 'c') + "\n" +
+                                 Flaser(2, "1", "0 0 0 0 0 0 1 h 1"));
+  EXPECT_EQ(ReadCarmenLog(under).scans.size(), 1U);
+}
+
 TEST(CarmenLog, CutOffLastLineIsDroppedWithAWarning) {
   const std::string complete = Flaser(4, "1.5", "0 0 0 0 0 0 1 h 1");
   std::string cut = Flaser(4, "1.5", "0 0 0 0 0 0 2 h 2");
