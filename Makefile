@@ -9,10 +9,12 @@ REPORT_DIR ?= $(BUILD_DIR)/report
 KEYPLACE_SHARED ?= ../shared
 SANITIZE_DIR ?= build-sanitize
 # The sanitizer run (docs/RELIABILITY.md, Sanitizers): the first report ends the test program
-# with its stack. allocator_may_return_null: an impossible allocation throws std::bad_alloc as
-# in the ordinary build (tests check the messages) instead of ending the process.
+# with its stack. allocator_may_return_null: an impossible allocation throws std::bad_alloc as in
+# the ordinary build (tests check the messages) instead of ending the process. Leaks of system
+# libraries only are suppressed (tests/sanitizers/lsan.supp).
 SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return_null=1:check_initialization_order=1 \
-  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0
 
 .PHONY: all deps configure build demo test test-sanitize bench report format format-check tidy \
   install clean
@@ -40,7 +42,7 @@ test: build format-check
 # test runs them).
 test-sanitize: deps
 	@cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g -DNDEBUG" -DKEYPLACE_SANITIZE=ON \
+	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DKEYPLACE_SANITIZE=ON \
 	  -DKEYPLACE_BUILD_BENCHMARKS=OFF \
 	  $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
