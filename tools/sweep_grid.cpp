@@ -199,9 +199,24 @@ SweepResults::SweepResults(std::string dir, nlohmann::json identity,
                         [&](std::ostream& out) { out << identity_.dump(2) << '\n'; });
   }
 
+  csv_header_ = header;
   // Rewrite the CSV with the valid rows only (drops a torn line), then append to it.
+  std::lock_guard<std::mutex> lock(mutex_);
+  WriteCsvLocked();
+  WriteJsonLocked();
+}
+
+void SweepResults::Sort() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  WriteCsvLocked();
+}
+
+void SweepResults::WriteCsvLocked() {
+  const std::filesystem::path csv_path = std::filesystem::path(dir_) / "results.csv";
+  // The stream would go on appending to the file the rename replaces.
+  if (csv_.is_open()) csv_.close();
   WriteFileAtomically(csv_path.string(), [&](std::ostream& out) {
-    out << header << '\n';
+    out << csv_header_ << '\n';
     for (const auto& [point, values] : rows_) {
       std::vector<double> row = point;
       row.insert(row.end(), values.begin(), values.end());
@@ -210,8 +225,6 @@ SweepResults::SweepResults(std::string dir, nlohmann::json identity,
   });
   csv_.open(csv_path, std::ios::app);
   if (!csv_) throw std::runtime_error(csv_path.string() + ": cannot open for appending");
-  std::lock_guard<std::mutex> lock(mutex_);
-  WriteJsonLocked();
 }
 
 bool SweepResults::Has(const std::vector<double>& point) const {

@@ -32,10 +32,11 @@ std::string PointKey(const std::vector<double>& point);
 
 /// The results of a sweep in DIR: `sweep.json` (what identifies the sweep: log, poses, fixed
 /// options), `results.csv` (header, then one row per finished point, appended and flushed as
-/// each point finishes) and `results.json` (all rows sorted by point, rewritten atomically after
-/// each point). Opening a DIR that already holds the same sweep loads its finished rows (a torn
-/// last line of an interrupted run is dropped); opening one that holds a different sweep throws
-/// std::invalid_argument naming the first differing field. Add() is thread-safe.
+/// each point finishes, rewritten sorted by point when opened and by Sort()) and `results.json`
+/// (all rows sorted by point, rewritten atomically after each point). Opening a DIR that already
+/// holds the same sweep loads its finished rows (a torn last line of an interrupted run is
+/// dropped); opening one that holds a different sweep throws std::invalid_argument naming the first
+/// differing field. Add() is thread-safe.
 class SweepResults {
  public:
   SweepResults(std::string dir, nlohmann::json identity, std::vector<std::string> parameter_columns,
@@ -46,8 +47,13 @@ class SweepResults {
   void Add(const std::vector<double>& point, const std::vector<double>& values);
   /// All rows (parameters then values), sorted by point.
   std::vector<std::vector<double>> SortedRows() const;
+  /// Rewrites results.csv with its rows sorted by point, as results.json is: rows are appended in
+  /// the order the points finish, which depends on the thread count, and a finished sweep's
+  /// files must not. Add() may follow.
+  void Sort();
 
  private:
+  void WriteCsvLocked();
   void WriteJsonLocked() const;
 
   std::string dir_;
@@ -55,6 +61,7 @@ class SweepResults {
   std::vector<std::string> parameter_columns_;
   std::vector<std::string> value_columns_;
   std::map<std::vector<double>, std::vector<double>> rows_;  // point -> values
+  std::string csv_header_;
   std::ofstream csv_;
   mutable std::mutex mutex_;
 };

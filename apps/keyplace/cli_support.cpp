@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include "io/atomic_file.hpp"
@@ -22,6 +23,15 @@ std::size_t WorkerThreads(int threads) {
   }
   return threads > 0 ? static_cast<std::size_t>(threads)
                      : static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+}
+
+void RunOnWorkerThreads(int threads, const std::function<void()>& work) {
+  const std::size_t count = WorkerThreads(threads);
+  // Each alone caps the threads at the cores: the global control lifts TBB's worker limit, the
+  // arena makes this work use that many.
+  const tbb::global_control control(tbb::global_control::max_allowed_parallelism, count);
+  tbb::task_arena arena(static_cast<int>(count));
+  arena.execute(work);
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,9 +28,14 @@ inline constexpr const char* kSkipBadLinesHelp =
 /// stderr, one "keyplace: warning: ..." line each.
 void PrintLogWarnings(const CarmenLog& log);
 
-/// The worker threads of --threads N (tbb::global_control's max_allowed_parallelism): N, or every
-/// core when N is 0. Throws std::invalid_argument for N < 0.
+/// The worker threads of --threads N: N, or every core when N is 0. Throws
+/// std::invalid_argument for N < 0.
 std::size_t WorkerThreads(int threads);
+
+/// Runs `work` with its parallel loops on exactly WorkerThreads(threads) threads, also when that
+/// is more than the cores (--threads 8 on two cores runs eight), so that a result's independence
+/// of the thread count can be checked on any machine.
+void RunOnWorkerThreads(int threads, const std::function<void()>& work);
 
 /// Seconds since `start` (steady clock).
 double SecondsSince(std::chrono::steady_clock::time_point start);

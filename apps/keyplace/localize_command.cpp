@@ -11,7 +11,6 @@
 #include <vector>
 
 #include <fmt/core.h>
-#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
@@ -92,8 +91,6 @@ void RunLocalize(const LocalizeOptions& options) {
                 {"--curve", options.curve_path},
                 {"--reliability", options.reliability_path}},
                input_paths);
-  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
-                                    WorkerThreads(options.query.threads));
   const bool baseline = !options.baseline.empty();
   if (!baseline && options.map_path.empty()) {
     throw std::invalid_argument("--map is required (except with --baseline tip-flirt)");
@@ -278,7 +275,8 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--reliability", options->reliability_path,
                       "Write the reliability diagram (TSV): accepted answers in 10 confidence "
                       "bins, mean confidence and observed precision per bin");
-  command->callback([options] { RunLocalize(*options); });
+  command->callback(
+      [options] { RunOnWorkerThreads(options->query.threads, [&] { RunLocalize(*options); }); });
 }
 
 }  // namespace keyplace::cli

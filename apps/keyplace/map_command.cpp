@@ -32,6 +32,7 @@ struct MapOptions {
   ConfigOptions config;
   bool overlap_only = false;
   bool skip_bad_lines = false;
+  int threads = 0;
 };
 
 // Table II was measured with the overlap criterion alone, Table VI with all criteria.
@@ -199,7 +200,13 @@ void RegisterMapCommand(CLI::App& app) {
                       "time split); the map's scan indices stay those of the whole file");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   AddConfigOptions(command, options->config);
-  command->callback([options] { RunMap(*options); });
+  command
+      ->add_option("--threads", options->threads,
+                   "Worker threads of the keypoint extraction (0 = all cores); the map does not "
+                   "depend on it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->callback([options] { RunOnWorkerThreads(options->threads, [&] { RunMap(*options); }); });
 }
 
 }  // namespace keyplace::cli

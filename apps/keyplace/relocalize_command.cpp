@@ -8,7 +8,6 @@
 #include <vector>
 
 #include <fmt/core.h>
-#include <tbb/global_control.h>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
@@ -56,8 +55,6 @@ void RunRelocalize(const RelocalizeOptions& options) {
                 {"--figure", options.figure_path}},
                {options.query.log_path, options.query.truth_path, options.query.index_path,
                 options.map_path});
-  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
-                                    WorkerThreads(options.query.threads));
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);
@@ -135,7 +132,8 @@ void RegisterRelocalizeCommand(CLI::App& app) {
                       "Write one TSV row per fix reported (pose, truth, error) to FILE");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
-  command->callback([options] { RunRelocalize(*options); });
+  command->callback(
+      [options] { RunOnWorkerThreads(options->query.threads, [&] { RunRelocalize(*options); }); });
 }
 
 }  // namespace keyplace::cli

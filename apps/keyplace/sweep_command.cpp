@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <fmt/core.h>
-#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
@@ -109,8 +108,6 @@ void RunSweepMapping(const SweepOptions& options) {
   const std::vector<std::vector<double>> grid = ExpandGrid(axes);
   const Config config = ResolveSweepConfig(options);
   for (const auto& point : grid) MappingConfigAt(config.mapping, point[0], point[1]);
-  tbb::global_control control(tbb::global_control::max_allowed_parallelism,
-                              WorkerThreads(options.threads));
   const LogInputs inputs = PrepareInputs(options, config, false);
   nlohmann::json identity = Identity("mapping", options, inputs, config);
   identity["overlap_only"] = options.overlap_only;
@@ -153,8 +150,6 @@ void RunSweepPlace(const SweepOptions& options) {
   const RankBy rank_by = options.config.preset == "paper" ? RankBy::kGamma : RankBy::kConfidence;
   const SelfMatchRule rule =
       options.exclude_shared_scans ? SelfMatchRule::kSharedScan : SelfMatchRule::kSameScans;
-  tbb::global_control control(tbb::global_control::max_allowed_parallelism,
-                              WorkerThreads(options.threads));
   const LogInputs inputs = PrepareInputs(options, config, true);
   const std::vector<std::string> parameters{"s_min", "l_g", "mu", "gamma_min", "lambda"};
   const std::vector<std::string> values{
@@ -225,7 +220,8 @@ void RegisterSweepCommand(CLI::App& app) {
   mapping_command->add_flag("--overlap-only", mapping->overlap_only,
                             "Complete submaps on the overlap criterion alone (as keyplace map)");
   AddCommonOptions(mapping_command, *mapping);
-  mapping_command->callback([mapping] { RunSweepMapping(*mapping); });
+  mapping_command->callback(
+      [mapping] { RunOnWorkerThreads(mapping->threads, [&] { RunSweepMapping(*mapping); }); });
 
   auto place = std::make_shared<SweepOptions>();
   CLI::App* place_command = sweep->add_subcommand(
@@ -246,7 +242,8 @@ void RegisterSweepCommand(CLI::App& app) {
   place_command->add_flag("--exclude-shared-scans", place->exclude_shared_scans,
                           "Skip every map submap sharing a scan with the query");
   AddCommonOptions(place_command, *place);
-  place_command->callback([place] { RunSweepPlace(*place); });
+  place_command->callback(
+      [place] { RunOnWorkerThreads(place->threads, [&] { RunSweepPlace(*place); }); });
 }
 
 }  // namespace keyplace::cli

@@ -50,6 +50,7 @@ std::size_t RunSweepPoints(
     progress.Update(done);
   });
   progress.Finish();
+  results.Sort();
   return finished.load();
 }
 

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "keyplace/features/flirt.hpp"
+#include "support/sanitizers.hpp"
 
 namespace keyplace {
 namespace {
@@ -66,6 +67,7 @@ rlim_t VirtualMemoryBytes() {
 // Formerly the geodesic distances took a dense n x n table: 512 MiB for 8192 beams (and 3.2 GB,
 // then std::bad_alloc, for 20 000); now this scan needs about 60 MiB.
 TEST(FlirtLimitsDeathTest, MemoryIsNotQuadraticInTheBeamCount) {
+  if (testing::kAddressSanitizer) GTEST_SKIP() << testing::kAddressSpaceLimitUnderAsan;
   ::testing::FLAGS_gtest_death_test_style = "threadsafe";
   EXPECT_EXIT(ExtractLargeScanWith256MiB(), ::testing::ExitedWithCode(0), "");
 }

@@ -16,6 +16,7 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/local_mapper.hpp"
 #include "keyplace/mapping/stability_grid.hpp"
+#include "support/sanitizers.hpp"
 
 namespace keyplace {
 namespace {
@@ -236,6 +237,7 @@ TEST(GlobalMapperBounds, AnOdometryGlitchEndsOneSubmapAndMappingGoesOn) {
 // Formerly the glitch grew one submap's grid to 1e6 x 330 cells (6.6 GB): the child process died
 // of std::bad_alloc.
 TEST(GlobalMapperBoundsDeathTest, AnOdometryGlitchNeedsNoGigabytes) {
+  if (testing::kAddressSanitizer) GTEST_SKIP() << testing::kAddressSpaceLimitUnderAsan;
   ::testing::FLAGS_gtest_death_test_style = "threadsafe";
   EXPECT_EXIT(MapGlitchLogIn2GiB(), ::testing::ExitedWithCode(0), "");
 }

@@ -96,5 +96,26 @@ TEST(SweepResults, ResumesDropsTornLineAndRefusesOtherSweeps) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(SweepResults, SortLeavesTheRowsInPointOrderWhateverOrderTheyFinishedIn) {
+  const auto dir = std::filesystem::temp_directory_path() / "keyplace_sweep_sort_test";
+  std::filesystem::remove_all(dir);
+  const auto text_of = [&] {
+    std::ifstream csv(dir / "results.csv");
+    return std::string((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  };
+  SweepResults results(dir.string(), {{"sweep", "t"}}, {"p", "q"}, {"v"});
+  results.Add({0.3, 1}, {1.5});
+  results.Add({0.1, 2}, {2.5});
+  results.Add({0.1, 1}, {3.5});
+  EXPECT_EQ(text_of(), "p,q,v\n0.3,1,1.5\n0.1,2,2.5\n0.1,1,3.5\n");
+  results.Sort();
+  EXPECT_EQ(text_of(), "p,q,v\n0.1,1,3.5\n0.1,2,2.5\n0.3,1,1.5\n");
+  results.Add({0.2, 1}, {4});  // still appends to the rewritten file
+  EXPECT_EQ(text_of(), "p,q,v\n0.1,1,3.5\n0.1,2,2.5\n0.3,1,1.5\n0.2,1,4\n");
+  results.Sort();
+  EXPECT_EQ(text_of(), "p,q,v\n0.1,1,3.5\n0.1,2,2.5\n0.2,1,4\n0.3,1,1.5\n");
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace keyplace::cli
