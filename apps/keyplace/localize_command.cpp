@@ -67,7 +67,7 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
 
 // The map among copies of the distractor maps' submaps, far away (the scale benchmark).
 GlobalMap WithDistractors(GlobalMap map, const std::vector<std::string>& paths,
-                          std::size_t total_submaps) {
+                          std::size_t total_submaps, int first_scan) {
   if (total_submaps <= map.submaps.size()) {
     throw std::invalid_argument(
         fmt::format("--distractor-submaps {} must exceed the map's {} submaps", total_submaps,
@@ -77,6 +77,7 @@ GlobalMap WithDistractors(GlobalMap map, const std::vector<std::string>& paths,
   for (const std::string& path : paths) sources.push_back(LoadMap(path));
   DistractorOptions distractors;
   distractors.total_submaps = total_submaps;
+  distractors.first_scan = first_scan;
   return EmbedAmongDistractors(map, sources, distractors);
 }
 
@@ -142,7 +143,12 @@ void RunLocalize(const LocalizeOptions& options) {
     map_description = fmt::format("{} ({} submaps, {} keypoints)", options.map_path,
                                   map.submaps.size(), map.KeypointCount());
     if (!options.distractor_paths.empty()) {
-      map = WithDistractors(std::move(map), options.distractor_paths, options.distractor_submaps);
+      // Past every scan of the query and truth logs: with --scans the queries follow the map's
+      // scans in the same file, and the self-match rule compares their indices.
+      const auto logs_scans =
+          std::max(inputs.file_scans, truth.truth_first_scan + truth.truth_poses.size());
+      map = WithDistractors(std::move(map), options.distractor_paths, options.distractor_submaps,
+                            static_cast<int>(logs_scans));
       map_description += fmt::format(" among distractors: {} submaps, {} keypoints",
                                      map.submaps.size(), map.KeypointCount());
     }

@@ -24,6 +24,7 @@ Extent ExtentOf(const GlobalMap& map) {
     high = high.cwiseMax(point_m);
   };
   for (const Submap& submap : map.submaps) {
+    if (submap.poses.empty()) continue;  // no frame to place its keypoints in
     for (const Pose2& pose : submap.poses) include(pose.translation());
     for (const StableKeypoint& keypoint : submap.keypoints) {
       include(submap.origin() * keypoint.position_m);
@@ -133,7 +134,7 @@ GlobalMap EmbedAmongDistractors(const GlobalMap& map, const std::vector<GlobalMa
 
   result.submaps.reserve(options.total_submaps);
   int next_id = LargestId(map) + 2;
-  int next_scan = LargestScan(map) + 1;
+  int next_scan = std::max(LargestScan(map) + 1, options.first_scan);
   for (std::size_t copy = 0; copy < copies; ++copy) {
     const GlobalMap& source = *used[copy % used.size()];
     const Pose2 T_world_source =

@@ -95,7 +95,23 @@ TEST(EmbedAmongDistractors, KeepsTheMapAndFillsUpWithMovedCopies) {
       EXPECT_GT(scan, 101 + 2 * 2);  // past the map's last scan
       EXPECT_TRUE(scans.insert(scan).second) << "scan " << scan << " used twice";
     }
+    // Each keypoint keeps naming the scan it was detected in.
+    for (std::size_t j = 0; j < real.keypoints.size(); ++j) {
+      EXPECT_EQ(copy.keypoints[j].scan_index, copy.scan_indices[j]) << "copy " << k;
+    }
     for (const Submap& own : map.submaps) EXPECT_GE(Distance(copy, own), 25.0) << "copy " << k;
+  }
+  // No two submaps of different copies come closer than the margin.
+  for (std::size_t a = 0; a < origin.size(); ++a) {
+    for (std::size_t b = a + 1; b < origin.size(); ++b) {
+      const Submap& first = embedded.submaps[3 + a];
+      const Submap& second = embedded.submaps[3 + b];
+      const bool same_copy = origin[b].first == origin[a].first &&
+                             origin[b].second - origin[a].second == static_cast<int>(b - a);
+      if (!same_copy) {
+        EXPECT_GE(Distance(first, second), 25.0) << a << " " << b;
+      }
+    }
   }
   // Within a copy the map neighbours stay neighbours (same relative pose, consecutive ids) ...
   for (std::size_t k = 1; k < origin.size(); ++k) {
@@ -112,6 +128,21 @@ TEST(EmbedAmongDistractors, KeepsTheMapAndFillsUpWithMovedCopies) {
       // ... and two copies lie margin_m apart.
       EXPECT_GE(Distance(before, copy), 25.0) << "copy submap " << k;
     }
+  }
+}
+
+TEST(EmbedAmongDistractors, ScansStartPastTheLogsTheyAreComparedWith) {
+  // A time split: the map holds scans 0..5 of a file whose queries are its scans 6..999.
+  const GlobalMap map = Corridor(3, 0.0, 0, 0);
+  DistractorOptions options;
+  options.total_submaps = 6;
+  options.first_scan = 1000;
+  const GlobalMap embedded = EmbedAmongDistractors(map, {Corridor(3, 0.0, 0, 0)}, options);
+  ASSERT_EQ(embedded.submaps.size(), 6U);
+  EXPECT_EQ(embedded.submaps[3].scan_indices.front(), 1000);
+  for (std::size_t i = 3; i < embedded.submaps.size(); ++i) {
+    for (const int scan : embedded.submaps[i].scan_indices) EXPECT_GE(scan, 1000);
+    for (const StableKeypoint& k : embedded.submaps[i].keypoints) EXPECT_GE(k.scan_index, 1000);
   }
 }
 
