@@ -265,7 +265,7 @@ TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
   std::size_t pairs_seen = 0;
   for (int trial = 0; trial < 6; ++trial) {
     const std::vector<Place> places = RandomPlaces(rng, bases);
-    // More query descriptors than one block of the dense product (64).
+    // About 100 query descriptors: the dense product takes all places in one block.
     std::vector<BetaGridDescriptor> query;
     for (const Place& place : RandomPlaces(rng, bases)) {
       if (query.size() < 100) {
@@ -316,6 +316,45 @@ TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
     }
   }
   EXPECT_GT(pairs_seen, 20000u);  // the sets do have pairs near every threshold
+}
+
+TEST(DescriptorIndex, DenseBlocksOfPlacesFindTheExhaustivePairs) {
+  // The dense product takes blocks of whole places whose H for all query rows fit its budget
+  // (2^19 values): 6000 query rows give blocks of a few places, 20000 blocks smaller than the
+  // largest places (40 keypoints), which then form a block alone.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> support(1, kBetaGridBins);
+  std::vector<BetaGridDescriptor> bases;
+  for (int k = 0; k < 12; ++k) bases.push_back(RandomDescriptor(rng, support(rng)));
+  const std::vector<Place> places = RandomPlaces(rng, bases);
+  std::vector<char> searched(places.size(), 1);
+  for (std::size_t p = 3; p < places.size(); p += 5) searched[p] = 0;
+  const SqrtDescriptorIndex index(places, Index::kDense);
+  for (const std::size_t rows : {std::size_t{6000}, std::size_t{20000}}) {
+    std::vector<BetaGridDescriptor> query;
+    while (query.size() < rows) {
+      for (const Place& place : RandomPlaces(rng, bases)) {
+        query.insert(query.end(), place.descriptors.begin(), place.descriptors.end());
+      }
+    }
+    query.resize(rows);
+    std::vector<std::vector<DescriptorPair>> below;
+    index.FindPairs(query, 0.4, searched, below);
+    std::size_t pairs = 0;
+    for (std::size_t p = 0; p < places.size(); ++p) {
+      const std::vector<DescriptorPair> expected =
+          searched[p] ? ExhaustiveBelow(query, places[p].descriptors, 0.4)
+                      : std::vector<DescriptorPair>{};
+      ASSERT_EQ(below[p].size(), expected.size()) << rows << " rows, place " << p;
+      for (std::size_t k = 0; k < expected.size(); ++k) {
+        ASSERT_EQ(below[p][k].current, expected[k].current) << rows << " rows, place " << p;
+        ASSERT_EQ(below[p][k].reference, expected[k].reference) << rows << " rows, place " << p;
+        ASSERT_EQ(below[p][k].distance, expected[k].distance) << rows << " rows, place " << p;
+      }
+      pairs += expected.size();
+    }
+    EXPECT_GT(pairs, rows);  // every block had pairs to find
+  }
 }
 
 TEST(DescriptorIndex, NoneHasNoIndexAndEmptyMapsWork) {
