@@ -386,6 +386,10 @@ class MapReader {
           if (!std::isfinite(keypoint.descriptor[bin])) {
             row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
           }
+          // Histograms: the descriptor index's bound (H <= 2 chi2) holds for bins >= 0 only.
+          if (keypoint.descriptor[bin] < 0.0f) {
+            row.Fail("descriptor", "bin " + std::to_string(bin) + " is negative");
+          }
         }
         submap.keypoints.push_back(keypoint);
       }

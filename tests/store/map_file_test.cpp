@@ -5,6 +5,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -57,7 +58,7 @@ GlobalMap RandomMap(int submaps, unsigned seed) {
       keypoint.scan_index = 10 * s + k % 5;
       keypoint.stability = static_cast<float>(uniform(rng));
       keypoint.occurrences = k;
-      for (auto& bin : keypoint.descriptor) bin = static_cast<float>(uniform(rng));
+      for (auto& bin : keypoint.descriptor) bin = static_cast<float>(std::abs(uniform(rng)));
       submap.keypoints.push_back(keypoint);
     }
     submap.occupancy.cell_size_m = 0.1;
@@ -447,6 +448,10 @@ TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
   // A NaN float32 (0x7fc00000, little endian) in the first bin of a 192-byte descriptor.
   const std::string kNanDescriptor = "UPDATE keypoints SET descriptor = x'0000c07f" +
                                      std::string(std::size_t{2} * 188, '0') + "' WHERE rowid = 8";
+  // -1.0f (0xbf800000) in bin 1: the index's bound needs histograms.
+  const std::string kNegativeDescriptor = "UPDATE keypoints SET descriptor = x'00000000000080bf" +
+                                          std::string(std::size_t{2} * 184, '0') +
+                                          "' WHERE rowid = 6";
   const struct {
     const char* sql;
     std::initializer_list<const char*> expected;
@@ -461,6 +466,8 @@ TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
        {"table keypoints, row 7, column descriptor: 191 bytes, expected 192 (48 float32)"}},
       {kNanDescriptor.c_str(),
        {"table keypoints, row 8, column descriptor: bin 0 is not a finite number"}},
+      {kNegativeDescriptor.c_str(),
+       {"table keypoints, row 6, column descriptor: bin 1 is negative"}},
       {"UPDATE keypoints SET descriptor = hex(descriptor) WHERE rowid = 9",
        {"table keypoints, row 9, column descriptor: not a blob"}},
       {"UPDATE keypoints SET level = -1 WHERE rowid = 2",
