@@ -4,8 +4,8 @@
 // 500 queries of `keyplace localize` (default preset; 10^2 is the map's first 100 submaps), with
 // the dense index and exhaustively (`none`, the oracle) in the same process. Counters per query:
 // s_per_query (CPU time of recognition), pairing_s and verification_s (wall), candidates (places
-// with >= mu pairs), correct (fraction of queries answered within 0.5 m / 10 deg), rss_mib (the
-// process's resident memory with this map and its recognizer).
+// with >= mu pairs), correct (fraction of queries answered within 0.5 m / 10 deg),
+// recognizer_mib (heap held by the recognizer: its places and descriptor index).
 //
 // Distractors: the maps named in KEYPLACE_DISTRACTOR_MAPS (colon-separated .kpm files; the
 // benchmark in docs/ uses the maps of the other buildings), else copies of the bundled map itself

@@ -23,6 +23,7 @@
 
 #include "store/map_checksum.hpp"
 #include "support/bundled_map.hpp"
+#include "support/sanitizers.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -556,6 +557,7 @@ TEST(MapFile, DeclaredCellCountsBeyondWhatTheBlobOrTheGridCanHoldAreRejected) {
 }
 
 TEST(MapFileDeathTest, AZlibBombDeclaringGigabytesLoadsNothing) {
+  if (testing::kAddressSanitizer) GTEST_SKIP() << testing::kAddressSpaceLimitUnderAsan;
   ::testing::FLAGS_gtest_death_test_style = "threadsafe";
   const std::string path = SavedRandomMap("bomb.kpm");
   SetOccupancy(path, 262'500'000, Compressed(std::vector<unsigned char>(1 << 20, 0), 9));
