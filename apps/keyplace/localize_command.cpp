@@ -66,7 +66,7 @@ std::vector<std::string> Aliases(const LocalizeOptions& o) {
 }
 
 // The map among copies of the distractor maps' submaps, far away (the scale benchmark).
-GlobalMap WithDistractors(GlobalMap map, const std::vector<std::string>& paths,
+GlobalMap WithDistractors(const GlobalMap& map, const std::vector<std::string>& paths,
                           std::size_t total_submaps, int first_scan) {
   if (total_submaps <= map.submaps.size()) {
     throw std::invalid_argument(
@@ -74,6 +74,7 @@ GlobalMap WithDistractors(GlobalMap map, const std::vector<std::string>& paths,
                     map.submaps.size()));
   }
   std::vector<GlobalMap> sources;
+  sources.reserve(paths.size());
   for (const std::string& path : paths) sources.push_back(LoadMap(path));
   DistractorOptions distractors;
   distractors.total_submaps = total_submaps;
@@ -147,7 +148,7 @@ void RunLocalize(const LocalizeOptions& options) {
       // scans in the same file, and the self-match rule compares their indices.
       const auto logs_scans =
           std::max(inputs.file_scans, truth.truth_first_scan + truth.truth_poses.size());
-      map = WithDistractors(std::move(map), options.distractor_paths, options.distractor_submaps,
+      map = WithDistractors(map, options.distractor_paths, options.distractor_submaps,
                             static_cast<int>(logs_scans));
       map_description += fmt::format(" among distractors: {} submaps, {} keypoints",
                                      map.submaps.size(), map.KeypointCount());

@@ -76,8 +76,10 @@ class Lattice {
 
   Eigen::Vector2d TileCentre(std::size_t copy) const {
     const std::size_t tile = copy + 1;
-    return centre_m_ + tile_m_ * Eigen::Vector2d(static_cast<double>(tile % side_),
-                                                 static_cast<double>(tile / side_));
+    const std::size_t column = tile % side_;
+    const std::size_t row = tile / side_;
+    return centre_m_ +
+           tile_m_ * Eigen::Vector2d(static_cast<double>(column), static_cast<double>(row));
   }
 
  private:
