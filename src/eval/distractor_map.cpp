@@ -38,33 +38,34 @@ Extent ExtentOf(const GlobalMap& map) {
   return {0.5 * (low + high), 0.5 * (high - low).norm()};
 }
 
-int LargestId(const GlobalMap& map) {
-  int largest = -1;
-  for (const Submap& submap : map.submaps) largest = std::max(largest, submap.id);
-  return largest;
-}
+// The ids and scan indices a map uses (scans 0..-1 when it has none).
+struct Numbering {
+  int first_id = std::numeric_limits<int>::max();
+  int last_id = -1;
+  int first_scan = std::numeric_limits<int>::max();
+  int last_scan = -1;
+};
 
-int LargestScan(const GlobalMap& map) {
-  int largest = -1;
+Numbering NumberingOf(const GlobalMap& map) {
+  Numbering numbering;
   for (const Submap& submap : map.submaps) {
-    for (const int scan : submap.scan_indices) largest = std::max(largest, scan);
+    numbering.first_id = std::min(numbering.first_id, submap.id);
+    numbering.last_id = std::max(numbering.last_id, submap.id);
+    for (const int scan : submap.scan_indices) {
+      numbering.first_scan = std::min(numbering.first_scan, scan);
+      numbering.last_scan = std::max(numbering.last_scan, scan);
+    }
   }
-  return largest;
+  if (numbering.last_scan < 0) numbering.first_scan = 0;
+  return numbering;
 }
 
-int SmallestId(const GlobalMap& map) {
-  int smallest = std::numeric_limits<int>::max();
-  for (const Submap& submap : map.submaps) smallest = std::min(smallest, submap.id);
-  return smallest;
-}
-
-int SmallestScan(const GlobalMap& map) {
-  int smallest = std::numeric_limits<int>::max();
-  for (const Submap& submap : map.submaps) {
-    for (const int scan : submap.scan_indices) smallest = std::min(smallest, scan);
-  }
-  return smallest == std::numeric_limits<int>::max() ? 0 : smallest;
-}
+// A distractor map with what every copy of it needs.
+struct Source {
+  const GlobalMap* map;
+  Extent extent;
+  Numbering numbering;
+};
 
 // Where the copies go: tile 0 holds the map, copy k tile k + 1 of a square lattice (row-major).
 class Lattice {
@@ -97,10 +98,10 @@ Pose2 CopyTransform(const Extent& source, const Eigen::Vector2d& tile_centre_m,
   return {tile_centre_m.x() - moved.x(), tile_centre_m.y() - moved.y(), heading_rad};
 }
 
-std::size_t CountCopies(const std::vector<const GlobalMap*>& sources, std::size_t distractors) {
+std::size_t CountCopies(const std::vector<Source>& sources, std::size_t distractors) {
   std::size_t copies = 0;
   for (std::size_t placed = 0; placed < distractors; ++copies) {
-    placed += sources[copies % sources.size()]->submaps.size();
+    placed += sources[copies % sources.size()].map->submaps.size();
   }
   return copies;
 }
@@ -115,19 +116,16 @@ GlobalMap EmbedAmongDistractors(const GlobalMap& map, const std::vector<GlobalMa
   GlobalMap result = map;
   if (options.total_submaps <= map.submaps.size()) return result;
   const std::size_t distractors = options.total_submaps - map.submaps.size();
-  std::vector<const GlobalMap*> used;
+  std::vector<Source> used;
+  const Extent map_extent = ExtentOf(map);
+  double largest_radius_m = map_extent.radius_m;
   for (const GlobalMap& source : sources) {
-    if (!source.submaps.empty()) used.push_back(&source);
+    if (source.submaps.empty()) continue;
+    used.push_back({&source, ExtentOf(source), NumberingOf(source)});
+    largest_radius_m = std::max(largest_radius_m, used.back().extent.radius_m);
   }
   if (used.empty()) {
     throw std::invalid_argument("distractors: the distractor maps hold no submap");
-  }
-  const Extent map_extent = ExtentOf(map);
-  std::vector<Extent> extents;
-  double largest_radius_m = map_extent.radius_m;
-  for (const GlobalMap* source : used) {
-    extents.push_back(ExtentOf(*source));
-    largest_radius_m = std::max(largest_radius_m, extents.back().radius_m);
   }
   const std::size_t copies = CountCopies(used, distractors);
   const Lattice lattice(map_extent.centre_m, 2.0 * largest_radius_m + options.margin_m, copies);
@@ -135,15 +133,16 @@ GlobalMap EmbedAmongDistractors(const GlobalMap& map, const std::vector<GlobalMa
   std::uniform_real_distribution<double> heading(-M_PI, M_PI);
 
   result.submaps.reserve(options.total_submaps);
-  int next_id = LargestId(map) + 2;
-  int next_scan = std::max(LargestScan(map) + 1, options.first_scan);
+  const Numbering own = NumberingOf(map);
+  int next_id = own.last_id + 2;
+  int next_scan = std::max(own.last_scan + 1, options.first_scan);
   for (std::size_t copy = 0; copy < copies; ++copy) {
-    const GlobalMap& source = *used[copy % used.size()];
+    const Source& source = used[copy % used.size()];
     const Pose2 T_world_source =
-        CopyTransform(extents[copy % used.size()], lattice.TileCentre(copy), heading(random));
-    const int first_id = next_id - SmallestId(source);
-    const int first_scan = next_scan - SmallestScan(source);
-    for (const Submap& original : source.submaps) {
+        CopyTransform(source.extent, lattice.TileCentre(copy), heading(random));
+    const int first_id = next_id - source.numbering.first_id;
+    const int first_scan = next_scan - source.numbering.first_scan;
+    for (const Submap& original : source.map->submaps) {
       if (result.submaps.size() == options.total_submaps) break;
       Submap submap = original;
       submap.id = first_id + original.id;
@@ -152,8 +151,8 @@ GlobalMap EmbedAmongDistractors(const GlobalMap& map, const std::vector<GlobalMa
       for (Pose2& pose : submap.poses) pose = T_world_source * pose;
       result.submaps.push_back(std::move(submap));
     }
-    next_id = LargestId(source) + first_id + 2;
-    next_scan = LargestScan(source) + first_scan + 1;
+    next_id = source.numbering.last_id + first_id + 2;
+    next_scan = source.numbering.last_scan + first_scan + 1;
   }
   return result;
 }
