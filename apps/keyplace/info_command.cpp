@@ -1,8 +1,8 @@
 // keyplace info LOG|MAP: what a log or a map contains; info --check MAP verifies a map file.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -14,6 +14,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "io/sqlite_magic.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/io/timestamps.hpp"
 #include "keyplace/mapping/global_map.hpp"
@@ -129,10 +130,10 @@ void PrintLog(const nlohmann::json& json) {
 bool IsSqliteFile(const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) return false;
-  char header[16] = {};
+  std::array<char, kSqliteMagic.size()> header{};
   std::ifstream in(path, std::ios::binary);
-  in.read(header, sizeof(header));
-  return in.gcount() == sizeof(header) && std::memcmp(header, "SQLite format 3", 16) == 0;
+  in.read(header.data(), header.size());
+  return StartsWithSqliteMagic(header.data(), static_cast<std::size_t>(in.gcount()));
 }
 
 nlohmann::json DescribeMap(const std::string& path, const GlobalMap& map) {

@@ -5,7 +5,6 @@
 #include <unistd.h>
 #include <zlib.h>
 
-#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "io/file_fingerprint.hpp"
+#include "io/sqlite_magic.hpp"
 
 namespace keyplace {
 namespace {
@@ -44,8 +44,7 @@ class LineReader {
     regular_ = S_ISREG(status.st_mode);
     // A pipe may deliver fewer bytes per read than the magic numbers need.
     EnsureRaw(kSqliteMagic.size());
-    if (raw_end_ >= kSqliteMagic.size() &&
-        std::memcmp(raw_.data(), kSqliteMagic.data(), kSqliteMagic.size()) == 0) {
+    if (StartsWithSqliteMagic(raw_.data(), raw_end_)) {
       throw std::invalid_argument(
           path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
           (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
@@ -108,8 +107,6 @@ class LineReader {
   static constexpr std::size_t kBufferBytes = 1 << 17;
   // 2 x 8192 numbers of up to 24 characters are 0.4 MiB: 4 MiB leaves room for any spelling.
   static constexpr std::size_t kMaxLineBytes = std::size_t{4} << 20;
-  static constexpr std::array<char, 16> kSqliteMagic = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f',
-                                                        'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
 
   // Appends up to the free space of raw_ after `at` from the input; 0 at its end.
   std::size_t ReadRaw(std::size_t at) {

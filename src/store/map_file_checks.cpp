@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/sqlite_magic.hpp"
 #include "store/map_schema.hpp"
 
 namespace keyplace {
@@ -141,7 +142,7 @@ MapFileFacts CheckMapFileHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   in.read(reinterpret_cast<char*>(header.data()), header.size());
   if (in.gcount() != static_cast<std::streamsize>(header.size()) ||
-      std::memcmp(header.data(), "SQLite format 3", 16) != 0) {
+      !StartsWithSqliteMagic(header.data(), header.size())) {
     throw std::runtime_error(path + ": not a keyplace map file (not an SQLite database)");
   }
   const std::uint32_t page_field = BigEndian(&header[16], 2);
