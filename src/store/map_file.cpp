@@ -287,113 +287,12 @@ class MapReader {
   }
 
   void ReadRows(const Database& db, GlobalMap& map) {
-    constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
     map.submaps.reserve(CountRows(db, "submaps"));
     const std::size_t pose_rows = CountRows(db, "poses");
     const std::size_t keypoint_rows = CountRows(db, "keypoints");
-    std::map<std::int64_t, std::size_t> index_of_id;
-    std::uint64_t occupancy_cells = 0;
-    {
-      Statement query(db,
-                      "SELECT id, overlap, distribution, forced, occupancy_cell_m, "
-                      "occupancy_cells, occupancy FROM submaps ORDER BY id");
-      while (query.Step()) {
-        const Row row(query, path_, "submaps");
-        Submap submap;
-        submap.id = row.Int(0, "id");
-        submap.overlap = row.Real(1, "overlap");
-        submap.distribution = row.Real(2, "distribution");
-        submap.forced = row.Integer(3, "forced", 0, 1) != 0;
-        submap.occupancy.cell_size_m = row.Real(4, "occupancy_cell_m");
-        if (submap.occupancy.cell_size_m < kMinCellSizeM ||
-            submap.occupancy.cell_size_m > kMaxCellSizeM) {
-          row.Fail("occupancy_cell_m", "outside [0.01, 10] m");
-        }
-        const std::int64_t cells =
-            row.Integer(5, "occupancy_cells", 0, std::numeric_limits<std::int64_t>::max());
-        // Checked before inflating: the cells are those of the submap's grid G, and what the
-        // blob could expand to at zlib's best.
-        if (cells > map.config.max_grid_cells) {
-          row.Fail("occupancy_cells", std::to_string(cells) +
-                                          " cells, more than the grid of a submap holds "
-                                          "(max_grid_cells = " +
-                                          std::to_string(map.config.max_grid_cells) + ")");
-        }
-        const auto [packed, packed_bytes] = row.Blob(6, "occupancy");
-        if (static_cast<std::uint64_t>(cells) * 8 > kMaxDeflateRatio * (packed_bytes + 1)) {
-          row.Fail("occupancy_cells",
-                   std::to_string(cells) + " cells (" + std::to_string(cells * 8) +
-                       " bytes) cannot come from a " + std::to_string(packed_bytes) +
-                       "-byte zlib blob (zlib expands at most 1032:1)");
-        }
-        submap.occupancy.cells = InflateOccupancy(row, packed, packed_bytes, cells);
-        occupancy_cells += submap.occupancy.cells.size();
-        index_of_id[submap.id] = map.submaps.size();
-        map.submaps.push_back(std::move(submap));
-      }
-    }
-    const auto submap_of = [&](const Row& row, std::int64_t id) -> Submap& {
-      const auto it = index_of_id.find(id);
-      if (it == index_of_id.end()) row.Fail("submap_id", "no submap " + std::to_string(id));
-      return map.submaps[it->second];
-    };
-    const auto check_seq = [](const Row& row, std::int64_t seq, std::size_t expected) {
-      if (seq != static_cast<std::int64_t>(expected)) {
-        row.Fail("seq", std::to_string(seq) + ", expected " + std::to_string(expected) +
-                            " (a row is missing or repeated)");
-      }
-    };
-    {
-      Statement query(db,
-                      "SELECT rowid, submap_id, seq, scan_index, x, y, theta FROM poses "
-                      "ORDER BY submap_id, seq");
-      while (query.Step()) {
-        const Row row(query, path_, "poses");
-        Submap& submap = submap_of(row, row.Integer(1, "submap_id", 0, kIntMax));
-        check_seq(row, row.Integer(2, "seq", 0, kIntMax), submap.poses.size());
-        submap.scan_indices.push_back(row.Int(3, "scan_index"));
-        submap.poses.emplace_back(row.Real(4, "x"), row.Real(5, "y"), row.Real(6, "theta"));
-      }
-    }
-    {
-      Statement query(db,
-                      "SELECT rowid, submap_id, seq, x, y, orientation, scale, level, scan_index, "
-                      "stability, occurrences, descriptor FROM keypoints ORDER BY submap_id, seq");
-      while (query.Step()) {
-        const Row row(query, path_, "keypoints");
-        Submap& submap = submap_of(row, row.Integer(1, "submap_id", 0, kIntMax));
-        check_seq(row, row.Integer(2, "seq", 0, kIntMax), submap.keypoints.size());
-        StableKeypoint keypoint;
-        keypoint.position_m = {row.Real(3, "x"), row.Real(4, "y")};
-        keypoint.orientation_rad = row.Real(5, "orientation");
-        keypoint.scale_m = row.Real(6, "scale");
-        keypoint.scale_level = row.Int(7, "level");
-        keypoint.scan_index = row.Int(8, "scan_index");
-        const double stability = row.Real(9, "stability");
-        if (std::abs(stability) > std::numeric_limits<float>::max()) {
-          row.Fail("stability", "beyond float range");
-        }
-        keypoint.stability = static_cast<float>(stability);
-        keypoint.occurrences = row.Int(10, "occurrences");
-        const auto [descriptor, descriptor_bytes] = row.Blob(11, "descriptor");
-        if (descriptor_bytes != sizeof(keypoint.descriptor)) {
-          row.Fail("descriptor", std::to_string(descriptor_bytes) + " bytes, expected " +
-                                     std::to_string(sizeof(keypoint.descriptor)) + " (" +
-                                     std::to_string(keypoint.descriptor.size()) + " float32)");
-        }
-        std::memcpy(keypoint.descriptor.data(), descriptor, descriptor_bytes);
-        for (std::size_t bin = 0; bin < keypoint.descriptor.size(); ++bin) {
-          if (!std::isfinite(keypoint.descriptor[bin])) {
-            row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
-          }
-          // Histograms: the descriptor index's bound (H <= 2 chi2) holds for bins >= 0 only.
-          if (keypoint.descriptor[bin] < 0.0f) {
-            row.Fail("descriptor", "bin " + std::to_string(bin) + " is negative");
-          }
-        }
-        submap.keypoints.push_back(keypoint);
-      }
-    }
+    const std::uint64_t occupancy_cells = ReadSubmaps(db, map);
+    ReadPoses(db, map);
+    ReadKeypoints(db, map);
     for (const Submap& submap : map.submaps) {
       if (submap.poses.empty()) {
         Fail("submap " + std::to_string(submap.id) + " has no poses");
@@ -405,12 +304,123 @@ class MapReader {
            " occupancy cells: every value finite and in range, every blob of its size");
   }
 
+  // The submaps table; returns the occupancy cells read.
+  std::uint64_t ReadSubmaps(const Database& db, GlobalMap& map) {
+    std::uint64_t occupancy_cells = 0;
+    Statement query(db,
+                    "SELECT id, overlap, distribution, forced, occupancy_cell_m, "
+                    "occupancy_cells, occupancy FROM submaps ORDER BY id");
+    while (query.Step()) {
+      const Row row(query, path_, "submaps");
+      Submap submap;
+      submap.id = row.Int(0, "id");
+      submap.overlap = row.Real(1, "overlap");
+      submap.distribution = row.Real(2, "distribution");
+      submap.forced = row.Integer(3, "forced", 0, 1) != 0;
+      submap.occupancy.cell_size_m = row.Real(4, "occupancy_cell_m");
+      if (submap.occupancy.cell_size_m < kMinCellSizeM ||
+          submap.occupancy.cell_size_m > kMaxCellSizeM) {
+        row.Fail("occupancy_cell_m", "outside [0.01, 10] m");
+      }
+      const std::int64_t cells =
+          row.Integer(5, "occupancy_cells", 0, std::numeric_limits<std::int64_t>::max());
+      // Checked before inflating: the cells are those of the submap's grid G, and what the
+      // blob could expand to at zlib's best.
+      if (cells > map.config.max_grid_cells) {
+        row.Fail("occupancy_cells", std::to_string(cells) +
+                                        " cells, more than the grid of a submap holds "
+                                        "(max_grid_cells = " +
+                                        std::to_string(map.config.max_grid_cells) + ")");
+      }
+      const auto [packed, packed_bytes] = row.Blob(6, "occupancy");
+      if (static_cast<std::uint64_t>(cells) * 8 > kMaxDeflateRatio * (packed_bytes + 1)) {
+        row.Fail("occupancy_cells", std::to_string(cells) + " cells (" + std::to_string(cells * 8) +
+                                        " bytes) cannot come from a " +
+                                        std::to_string(packed_bytes) +
+                                        "-byte zlib blob (zlib expands at most 1032:1)");
+      }
+      submap.occupancy.cells = InflateOccupancy(row, packed, packed_bytes, cells);
+      occupancy_cells += submap.occupancy.cells.size();
+      index_of_id_[submap.id] = map.submaps.size();
+      map.submaps.push_back(std::move(submap));
+    }
+    return occupancy_cells;
+  }
+
+  void ReadPoses(const Database& db, GlobalMap& map) {
+    Statement query(db,
+                    "SELECT rowid, submap_id, seq, scan_index, x, y, theta FROM poses "
+                    "ORDER BY submap_id, seq");
+    while (query.Step()) {
+      const Row row(query, path_, "poses");
+      Submap& submap = SubmapOf(row, map, row.Integer(1, "submap_id", 0, kIntMax));
+      CheckSeq(row, row.Integer(2, "seq", 0, kIntMax), submap.poses.size());
+      submap.scan_indices.push_back(row.Int(3, "scan_index"));
+      submap.poses.emplace_back(row.Real(4, "x"), row.Real(5, "y"), row.Real(6, "theta"));
+    }
+  }
+
+  void ReadKeypoints(const Database& db, GlobalMap& map) {
+    Statement query(db,
+                    "SELECT rowid, submap_id, seq, x, y, orientation, scale, level, scan_index, "
+                    "stability, occurrences, descriptor FROM keypoints ORDER BY submap_id, seq");
+    while (query.Step()) {
+      const Row row(query, path_, "keypoints");
+      Submap& submap = SubmapOf(row, map, row.Integer(1, "submap_id", 0, kIntMax));
+      CheckSeq(row, row.Integer(2, "seq", 0, kIntMax), submap.keypoints.size());
+      StableKeypoint keypoint;
+      keypoint.position_m = {row.Real(3, "x"), row.Real(4, "y")};
+      keypoint.orientation_rad = row.Real(5, "orientation");
+      keypoint.scale_m = row.Real(6, "scale");
+      keypoint.scale_level = row.Int(7, "level");
+      keypoint.scan_index = row.Int(8, "scan_index");
+      const double stability = row.Real(9, "stability");
+      if (std::abs(stability) > std::numeric_limits<float>::max()) {
+        row.Fail("stability", "beyond float range");
+      }
+      keypoint.stability = static_cast<float>(stability);
+      keypoint.occurrences = row.Int(10, "occurrences");
+      const auto [descriptor, descriptor_bytes] = row.Blob(11, "descriptor");
+      if (descriptor_bytes != sizeof(keypoint.descriptor)) {
+        row.Fail("descriptor", std::to_string(descriptor_bytes) + " bytes, expected " +
+                                   std::to_string(sizeof(keypoint.descriptor)) + " (" +
+                                   std::to_string(keypoint.descriptor.size()) + " float32)");
+      }
+      std::memcpy(keypoint.descriptor.data(), descriptor, descriptor_bytes);
+      for (std::size_t bin = 0; bin < keypoint.descriptor.size(); ++bin) {
+        if (!std::isfinite(keypoint.descriptor[bin])) {
+          row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
+        }
+        // Histograms: the descriptor index's bound (H <= 2 chi2) holds for bins >= 0 only.
+        if (keypoint.descriptor[bin] < 0.0f) {
+          row.Fail("descriptor", "bin " + std::to_string(bin) + " is negative");
+        }
+      }
+      submap.keypoints.push_back(keypoint);
+    }
+  }
+
+  Submap& SubmapOf(const Row& row, GlobalMap& map, std::int64_t id) const {
+    const auto it = index_of_id_.find(id);
+    if (it == index_of_id_.end()) row.Fail("submap_id", "no submap " + std::to_string(id));
+    return map.submaps[it->second];
+  }
+
+  static void CheckSeq(const Row& row, std::int64_t seq, std::size_t expected) {
+    if (seq != static_cast<std::int64_t>(expected)) {
+      row.Fail("seq", std::to_string(seq) + ", expected " + std::to_string(expected) +
+                          " (a row is missing or repeated)");
+    }
+  }
+
   const std::string& path_;
   std::vector<std::string>* passed_;
   int* schema_version_;
   std::uint64_t file_bytes_ = 0;
   StepBudget budget_;
   std::map<std::string, std::string> meta_;
+  std::map<std::int64_t, std::size_t> index_of_id_;  // submap id -> index in map.submaps
+  static constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
 };
 
 // ---------------------------------------------------------------------------------------------
