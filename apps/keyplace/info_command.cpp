@@ -50,29 +50,11 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
   json["lines"] = log.lines;
   json["scans"] = log.scans.size();
   json["pose_kind"] = log.corrected ? "corrected" : "odometry";
-  std::size_t min_beams = 0;
-  std::size_t max_beams = 0;
-  std::size_t total_beams = 0;
-  double fov_deg = 0.0;
-  if (!log.scans.empty()) {
-    min_beams = max_beams = log.scans.front().size();
-    for (const auto& scan : log.scans) {
-      min_beams = std::min(min_beams, scan.size());
-      max_beams = std::max(max_beams, scan.size());
-      total_beams += scan.size();
-    }
-    const auto& first = log.scans.front();
-    if (first.size() > 1) {
-      const double step = (first.angles_rad.back() - first.angles_rad.front()) /
-                          static_cast<double>(first.size() - 1);
-      fov_deg = (first.angles_rad.back() - first.angles_rad.front() + step) * 180.0 / M_PI;
-    }
-    json["max_range_m"] = first.max_range_m;
-  }
-  json["beams_per_scan_min"] = min_beams;
-  json["beams_per_scan_max"] = max_beams;
-  json["beams_total"] = total_beams;
-  json["field_of_view_deg"] = fov_deg;
+  if (!log.scans.empty()) json["max_range_m"] = log.scans.front().max_range_m;
+  json["beams_per_scan_min"] = log.beams_per_scan_min;
+  json["beams_per_scan_max"] = log.beams_per_scan_max;
+  json["beams_total"] = log.beams_total;
+  json["field_of_view_deg"] = log.first_scan_field_of_view_rad * 180.0 / M_PI;
   json["invalid_beams"] = log.invalid_beams;
   json["no_return_beams"] = log.no_return_beams;
   double duration_s = 0.0;
@@ -249,6 +231,7 @@ void RunInfo(const InfoOptions& options) {
   } else {
     CarmenReadOptions reading;
     reading.skip_bad_lines = options.skip_bad_lines;
+    reading.keep_beams = false;  // a summary: logs larger than memory can be described
     const CarmenLog log = ReadLogWithScans(options.input, reading);
     PrintLogWarnings(log);
     json = DescribeLog(log);

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -39,6 +40,11 @@ int Run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return Run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    // Readers and loaders name their file when memory runs out; this is what is left.
+    std::fprintf(stderr,
+                 "keyplace: error: out of memory (the input is too large for this machine's "
+                 "memory)\n");
   } catch (const std::exception& error) {
     std::fprintf(stderr, "keyplace: error: %s\n", error.what());
   } catch (...) {

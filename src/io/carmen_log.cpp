@@ -5,6 +5,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -25,6 +27,9 @@
 
 namespace keyplace {
 namespace {
+
+// A held beam: its range and bearing (double) and its validity flag.
+constexpr std::size_t kBytesPerHeldBeam = 2 * sizeof(double) + sizeof(std::uint8_t);
 
 // Reads a plain or gzip-compressed text file line by line, once, front to back: the input may be a
 // pipe or a FIFO (`keyplace info <(zcat log.gz)`), which can be neither reopened nor rewound, so
@@ -606,6 +611,28 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
   return scan;
 }
 
+// Counts the scan's beams and keeps it, without its beams unless the options keep them.
+void AddScan(LogScan scan, ReaderState& state) {
+  CarmenLog& log = state.log;
+  const std::size_t beams = scan.size();
+  if (log.scans.empty()) {
+    log.beams_per_scan_min = log.beams_per_scan_max = beams;
+    if (beams > 1) {
+      const double span_rad = scan.angles_rad.back() - scan.angles_rad.front();
+      log.first_scan_field_of_view_rad = span_rad + span_rad / static_cast<double>(beams - 1);
+    }
+  }
+  log.beams_per_scan_min = std::min(log.beams_per_scan_min, beams);
+  log.beams_per_scan_max = std::max(log.beams_per_scan_max, beams);
+  log.beams_total += beams;
+  if (!state.options.keep_beams) {
+    std::vector<double>().swap(scan.ranges_m);
+    std::vector<double>().swap(scan.angles_rad);
+    std::vector<std::uint8_t>().swap(scan.valid);
+  }
+  log.scans.push_back(std::move(scan));
+}
+
 void ParseLine(const std::string& path, std::size_t line_number,
                const std::vector<std::string_view>& tokens, ReaderState& state) {
   CarmenLog& log = state.log;
@@ -620,11 +647,11 @@ void ParseLine(const std::string& path, std::size_t line_number,
   }
   const FieldParser fields(path, line_number, tokens, state.options.max_coordinate_m);
   if (type == "FLASER") {
-    log.scans.push_back(ParseFlaser(fields, line_number, state, true));
+    AddScan(ParseFlaser(fields, line_number, state, true), state);
   } else if (type == "RLASER") {
     ParseFlaser(fields, line_number, state, false);  // validated and counted, not a front scan
   } else if (type == "ROBOTLASER1") {
-    log.scans.push_back(ParseRobotLaser(fields, line_number, state));
+    AddScan(ParseRobotLaser(fields, line_number, state), state);
   } else if (type == "ODOM") {
     fields.ExpectFieldCount(10, "ODOM x y theta tv rv accel ipc_timestamp host logger_timestamp");
     OdometryMessage odom;
@@ -668,23 +695,14 @@ void ParseLine(const std::string& path, std::size_t line_number,
   ++log.line_counts[std::string(type)];
 }
 
-}  // namespace
-
-CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
-  if (!(options.flaser_max_range_m > 0.0)) {
-    throw std::invalid_argument("CarmenReadOptions.flaser_max_range_m must be positive");
-  }
-  if (!(options.max_coordinate_m > 0.0)) {
-    throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
-  }
-  ReaderState state;
-  state.options = options;
-  state.log.path = path;
-  LineReader reader(path);
+// Reads every line into state; the text of the first skipped line's error goes to
+// first_skipped_error.
+void ReadLines(const std::string& path, LineReader& reader, ReaderState& state,
+               std::string& first_skipped_error) {
+  const CarmenReadOptions& options = state.options;
+  CarmenLog& log = state.log;
   std::string line;
   std::vector<std::string_view> tokens;
-  CarmenLog& log = state.log;
-  std::string first_skipped_error;
   while (reader.Next(line)) {
     Tokenize(line, tokens);
     if (tokens.empty()) continue;
@@ -713,6 +731,42 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
                                     "CarmenReadOptions::skip_bad_lines)");
       }
     }
+  }
+}
+
+// What a reader out of memory says instead of a bare std::bad_alloc: where it was and how much
+// it held, so the user knows the log itself is too large for this machine.
+std::string OutOfMemoryText(const std::string& path, std::size_t line_number,
+                            const ReaderState& state) {
+  const CarmenLog& log = state.log;
+  const std::size_t beams = state.options.keep_beams ? log.beams_total : 0;
+  const std::size_t held_mib =
+      (beams * kBytesPerHeldBeam + log.scans.size() * sizeof(LogScan)) >> 20U;
+  return path + ":" + std::to_string(line_number) + ": out of memory after reading " +
+         std::to_string(log.scans.size()) + " scans (about " + std::to_string(held_mib) +
+         " MiB held: the whole log is kept in memory, " + std::to_string(kBytesPerHeldBeam) +
+         " bytes per beam); split the log or use a machine with more memory";
+}
+
+}  // namespace
+
+CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
+  if (!(options.flaser_max_range_m > 0.0)) {
+    throw std::invalid_argument("CarmenReadOptions.flaser_max_range_m must be positive");
+  }
+  if (!(options.max_coordinate_m > 0.0)) {
+    throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
+  }
+  ReaderState state;
+  state.options = options;
+  state.log.path = path;
+  LineReader reader(path);
+  CarmenLog& log = state.log;
+  std::string first_skipped_error;
+  try {
+    ReadLines(path, reader, state, first_skipped_error);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(OutOfMemoryText(path, reader.line_number(), state));
   }
   if (log.skipped_lines > 0) {
     std::string numbers;

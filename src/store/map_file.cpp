@@ -11,8 +11,10 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -528,7 +530,18 @@ void SaveMap(const GlobalMap& map, const std::string& path) {
   }
 }
 
-GlobalMap LoadMap(const std::string& path) { return MapReader(path, nullptr, nullptr).Read(); }
+GlobalMap LoadMap(const std::string& path) {
+  try {
+    return MapReader(path, nullptr, nullptr).Read();
+  } catch (const std::bad_alloc&) {
+    // The loader bounds every count and blob by the file's size, so this is a map too large for
+    // the memory left, not a hostile file: say which file, not a bare std::bad_alloc.
+    std::error_code error;
+    const auto bytes = std::filesystem::file_size(path, error);
+    throw std::runtime_error(path + ": out of memory while loading the map" +
+                             (error ? std::string() : " (" + std::to_string(bytes) + " bytes)"));
+  }
+}
 
 MapFileCheck CheckMapFile(const std::string& path) {
   MapFileCheck check;

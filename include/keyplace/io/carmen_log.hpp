@@ -63,7 +63,13 @@ struct CarmenLog {
   // a pipe cannot be read a second time. Maps record it as source_hash. Empty for a log built
   // in memory.
   std::string fingerprint;
-  std::uint64_t file_bytes = 0;     // bytes read from the file (compressed ones for a .gz)
+  std::uint64_t file_bytes = 0;  // bytes read from the file (compressed ones for a .gz)
+  // Beams per scan over all scans, and the first scan's field of view (first to last bearing plus
+  // one step): counted as the scans are read, so known also when their beams are not kept.
+  std::size_t beams_total = 0;
+  std::size_t beams_per_scan_min = 0;
+  std::size_t beams_per_scan_max = 0;
+  double first_scan_field_of_view_rad = 0.0;
   std::size_t invalid_beams = 0;    // beams marked invalid because of NaN/inf/negative values
   std::size_t no_return_beams = 0;  // beams at or beyond max range (normal "no echo")
   // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
@@ -95,6 +101,10 @@ struct CarmenReadOptions {
   // Skip malformed lines (counted in CarmenLog::skipped_lines, with a warning) instead of
   // stopping at the first one.
   bool skip_bad_lines = false;
+  // false: each scan's ranges, bearings and validity flags are counted and then released, so a
+  // summary of a log (keyplace info) holds about 200 bytes per scan instead of 17 per beam. The
+  // scans then have size() 0; only their stamps and poses are kept.
+  bool keep_beams = true;
 };
 
 /// Reads a CARMEN log. Throws std::invalid_argument naming file, line and field on malformed
