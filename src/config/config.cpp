@@ -18,7 +18,8 @@ const ConfigFields<Config>& ConfigTable() {
         .Nested("place", &Config::place, PlaceConfigFields())
         .Nested("slam", &Config::slam, SlamConfigFields())
         .Nested("localization", &Config::localization, LocalizerConfigFields())
-        .Nested("evaluation", &Config::evaluation, EvaluationConfigFields());
+        .Nested("evaluation", &Config::evaluation, EvaluationConfigFields())
+        .Nested("grid", &Config::grid, OccupancyGridConfigFields());
     return table;
   }();
   return fields;
@@ -34,6 +35,7 @@ void ValidateSection(const std::string& key, const Config& config) {
   if (section == "slam") Validate(ToSlamConfig(config));
   if (section == "localization") Validate(ToLocalizerConfig(config));
   if (section == "evaluation") Validate(config.evaluation);
+  if (section == "grid") Validate(config.grid);
 }
 
 }  // namespace
@@ -148,6 +150,7 @@ void Validate(const Config& config) {
   Validate(ToSlamConfig(config));
   Validate(ToLocalizerConfig(config));
   Validate(config.evaluation);
+  Validate(config.grid);
 }
 
 std::vector<ConfigFieldInfo> DescribeConfig(const Config& config) {

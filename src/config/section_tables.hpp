@@ -7,6 +7,7 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
+#include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/registration/icp.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
@@ -27,5 +28,6 @@ const ConfigFields<LoopRefinementConfig>& LoopRefinementConfigFields();
 const ConfigFields<SlamConfig>& SlamConfigFields();
 const ConfigFields<LocalizerConfig>& LocalizerConfigFields();
 const ConfigFields<EvaluationConfig>& EvaluationConfigFields();
+const ConfigFields<OccupancyGridConfig>& OccupancyGridConfigFields();
 
 }  // namespace keyplace

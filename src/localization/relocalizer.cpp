@@ -88,6 +88,15 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
     update.T_world_robot = T_world_odom_ * T_odom_robot;
     update.confidence = fix_confidence_;
     update.unconfirmed_m = odometry_m_ - confirmed_at_m_;
+    // The filter's own uncertainty now: the fix's variance plus the drift allowance since its
+    // last confirmation. Heading is fused with the same weights (Confirm), so its variance is
+    // the answers' heading variance (agree_deg / 2, one sigma) scaled alike.
+    const double drift_m = policy_.agree_per_m * update.unconfirmed_m;
+    const double answer_variance_m2 = 0.25 * policy_.agree_m * policy_.agree_m;
+    const double answer_heading_sigma_rad = 0.5 * policy_.agree_deg * kRadPerDeg;
+    update.position_variance_m2 = fix_variance_m2_ + drift_m * drift_m;
+    update.heading_variance_rad2 = update.position_variance_m2 / answer_variance_m2 *
+                                   answer_heading_sigma_rad * answer_heading_sigma_rad;
   }
   return update;
 }

@@ -12,6 +12,7 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
+#include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
 #include "keyplace/slam/online_slam.hpp"
@@ -27,6 +28,7 @@ struct Config {
                                  // odometry, mapping and place are the sections above
   LocalizerConfig localization;  // streaming localizer; its place is the section above
   EvaluationConfig evaluation;   // evaluation settings (not the method's)
+  OccupancyGridConfig grid;      // occupancy grids for navigation stacks (docs/ROS.md)
 };
 
 /// The SLAM configuration with the odometry, mapping and place sections put in.

@@ -53,6 +53,10 @@ struct RelocalizationUpdate {
   double confidence = 0.0;
   // Odometry distance since the last answer that confirmed the fix (0 without a fix).
   double unconfirmed_m = 0.0;
+  // Valid when status is kFixed: the variance of the fix's position (each of x and y; isotropic)
+  // and heading, as the filter weighs answers against odometry drift (docs/LOCALIZATION.md).
+  double position_variance_m2 = 0.0;
+  double heading_variance_rad2 = 0.0;
   // The localizer's answer when a query submap completed with this scan.
   std::optional<LocalizationResult> answer;
   // The answer was accepted and agreed with the fix (confirmation) or contradicted it.

@@ -1,0 +1,35 @@
+#pragma once
+// A fix as a ROS geometry_msgs/PoseWithCovarianceStamped, ready to publish on /initialpose for
+// AMCL or nav2 (docs/ROS.md): `rostopic pub -f fix.yaml /initialpose
+// geometry_msgs/PoseWithCovarianceStamped`, or the same fields in JSON.
+
+#include <string>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/localization/relocalizer.hpp"
+
+namespace keyplace {
+
+struct InitialPose {
+  std::string frame_id = "map";  // the map's frame: the grid keyplace exports is in it
+  Pose2 T_map_robot;
+  double position_variance_m2 = 0.0;  // of x and of y
+  double heading_variance_rad2 = 0.0;
+};
+
+/// The fix of an update whose status is kFixed (std::invalid_argument otherwise), with the
+/// filter's variances.
+InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string& frame_id = "map");
+
+/// The message as YAML (header without stamp: a zero stamp means "now" to AMCL, and leaving it
+/// out keeps the text valid for ROS 1's secs/nsecs and ROS 2's sec/nanosec alike). The 6x6
+/// covariance is row-major over x, y, z, roll, pitch, yaw; z, roll and pitch are 0.
+std::string InitialPoseYaml(const InitialPose& pose);
+/// The same fields as JSON.
+std::string InitialPoseJson(const InitialPose& pose);
+
+/// Writes YAML, or JSON when the path ends in ".json", atomically. Throws std::runtime_error
+/// naming the path when it cannot be written.
+void WriteInitialPose(const InitialPose& pose, const std::string& path);
+
+}  // namespace keyplace

@@ -1,0 +1,80 @@
+#include "keyplace/localization/initial_pose.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "io/atomic_file.hpp"
+
+namespace keyplace {
+namespace {
+
+constexpr std::size_t kX = 0;
+constexpr std::size_t kY = 7;
+constexpr std::size_t kYaw = 35;
+
+std::array<double, 36> Covariance(const InitialPose& pose) {
+  std::array<double, 36> covariance{};
+  covariance[kX] = pose.position_variance_m2;
+  covariance[kY] = pose.position_variance_m2;
+  covariance[kYaw] = pose.heading_variance_rad2;
+  return covariance;
+}
+
+std::string Shortest(double value) {
+  std::array<char, 32> text{};
+  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
+  return {text.data(), result.ptr};
+}
+
+bool EndsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() &&
+         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The message's fields in the flow style both YAML and (with quoted keys) JSON take.
+std::string MessageText(const InitialPose& pose, bool json) {
+  const auto key = [json](const char* name) {
+    return json ? "\"" + std::string(name) + "\": " : std::string(name) + ": ";
+  };
+  const double half_rad = 0.5 * pose.T_map_robot.theta;
+  std::string covariance;
+  for (const double value : Covariance(pose)) {
+    covariance += (covariance.empty() ? "" : ", ") + Shortest(value);
+  }
+  const std::string frame = json ? "\"" + pose.frame_id + "\"" : pose.frame_id;
+  return "{" + key("header") + "{" + key("frame_id") + frame + "}, " + key("pose") + "{" +
+         key("pose") + "{" + key("position") + "{" + key("x") + Shortest(pose.T_map_robot.x) +
+         ", " + key("y") + Shortest(pose.T_map_robot.y) + ", " + key("z") + "0.0}, " +
+         key("orientation") + "{" + key("x") + "0.0, " + key("y") + "0.0, " + key("z") +
+         Shortest(std::sin(half_rad)) + ", " + key("w") + Shortest(std::cos(half_rad)) + "}}, " +
+         key("covariance") + "[" + covariance + "]}}\n";
+}
+
+}  // namespace
+
+InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string& frame_id) {
+  if (update.status != FixStatus::kFixed) {
+    throw std::invalid_argument("an initial pose needs a fix; the localizer is " +
+                                ToString(update.status));
+  }
+  InitialPose pose;
+  pose.frame_id = frame_id;
+  pose.T_map_robot = update.T_world_robot;
+  pose.position_variance_m2 = update.position_variance_m2;
+  pose.heading_variance_rad2 = update.heading_variance_rad2;
+  return pose;
+}
+
+std::string InitialPoseYaml(const InitialPose& pose) { return MessageText(pose, false); }
+
+std::string InitialPoseJson(const InitialPose& pose) { return MessageText(pose, true); }
+
+void WriteInitialPose(const InitialPose& pose, const std::string& path) {
+  const std::string text = EndsWith(path, ".json") ? InitialPoseJson(pose) : InitialPoseYaml(pose);
+  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace keyplace

@@ -1,0 +1,183 @@
+#include "keyplace/mapping/map_server.hpp"
+
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "io/atomic_file.hpp"
+
+namespace keyplace {
+namespace {
+
+// The shortest text that reads back as the same double.
+std::string Shortest(double value) {
+  std::array<char, 32> text{};
+  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
+  return {text.data(), result.ptr};
+}
+
+std::uint8_t PixelOf(CellState state) {
+  switch (state) {
+    case CellState::kOccupied:
+      return kMapServerOccupied;
+    case CellState::kFree:
+      return kMapServerFree;
+    case CellState::kUnknown:
+      break;
+  }
+  return kMapServerUnknown;
+}
+
+void WriteImage(const OccupancyGrid& grid, const OccupancyGridConfig& config,
+                const std::string& path) {
+  std::vector<char> pixels;
+  pixels.reserve(static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height));
+  for (int row = grid.height - 1; row >= 0; --row) {  // the image's first row is the top
+    for (int column = 0; column < grid.width; ++column) {
+      pixels.push_back(static_cast<char>(PixelOf(grid.State(column, row, config))));
+    }
+  }
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "P5\n# keyplace occupancy grid, " << grid.resolution_m << " m per pixel\n"
+        << grid.width << ' ' << grid.height << "\n255\n";
+    out.write(pixels.data(), static_cast<std::streamsize>(pixels.size()));
+  });
+}
+
+[[noreturn]] void Fail(const std::string& path, const std::string& problem) {
+  throw std::invalid_argument(path + ": " + problem);
+}
+
+// The next whitespace-separated header token of a PGM, skipping '#' comments.
+std::string HeaderToken(const std::string& bytes, std::size_t& at) {
+  while (at < bytes.size()) {
+    if (bytes[at] == '#') {
+      while (at < bytes.size() && bytes[at] != '\n') ++at;
+    } else if (std::isspace(static_cast<unsigned char>(bytes[at])) != 0) {
+      ++at;
+    } else {
+      break;
+    }
+  }
+  const std::size_t start = at;
+  while (at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at])) == 0) ++at;
+  return bytes.substr(start, at - start);
+}
+
+int HeaderNumber(const std::string& bytes, std::size_t& at, const std::string& path,
+                 const char* field) {
+  const std::string token = HeaderToken(bytes, at);
+  if (token.empty() || token.size() > 6 ||
+      token.find_first_not_of("0123456789") != std::string::npos) {
+    Fail(path,
+         std::string("PGM header field ") + field + " is '" + token + "', not a number below 10^6");
+  }
+  return std::stoi(token);
+}
+
+void ReadImage(MapServerMap& map) {
+  const std::string& path = map.image_path;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the map image");
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::size_t at = 0;
+  if (HeaderToken(bytes, at) != "P5") Fail(path, "not a binary PGM image (magic P5)");
+  map.width = HeaderNumber(bytes, at, path, "width");
+  map.height = HeaderNumber(bytes, at, path, "height");
+  if (HeaderNumber(bytes, at, path, "maxval") != 255) Fail(path, "maxval must be 255 (8 bits)");
+  ++at;  // the single whitespace after maxval
+  const std::size_t count =
+      static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height);
+  if (bytes.size() < at + count) {
+    Fail(path, std::to_string(map.width) + " x " + std::to_string(map.height) +
+                   " pixels declared, " +
+                   std::to_string(bytes.size() > at ? bytes.size() - at : 0) +
+                   " bytes of pixels present");
+  }
+  map.pixels.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                    bytes.begin() + static_cast<std::ptrdiff_t>(at + count));
+}
+
+template <typename Value>
+Value Required(const YAML::Node& root, const char* key, const std::string& path) {
+  const YAML::Node node = root[key];
+  if (!node) Fail(path, std::string("missing key '") + key + "'");
+  try {
+    return node.as<Value>();
+  } catch (const YAML::Exception&) {
+    Fail(path,
+         "line " + std::to_string(node.Mark().line + 1) + ": key '" + key + "' has the wrong type");
+  }
+}
+
+}  // namespace
+
+std::string MapServerImagePath(const std::string& yaml_path) {
+  return std::filesystem::path(yaml_path).replace_extension(".pgm").string();
+}
+
+void WriteMapServerMap(const OccupancyGrid& grid, const OccupancyGridConfig& config,
+                       const std::string& yaml_path) {
+  if (grid.width <= 0 || grid.height <= 0) {
+    throw std::invalid_argument(yaml_path + ": the occupancy grid is empty (no beam was traced)");
+  }
+  const std::string image_path = MapServerImagePath(yaml_path);
+  WriteImage(grid, config, image_path);
+  WriteFileAtomically(yaml_path, [&](std::ostream& out) {
+    // The image is named relative to the YAML, so the pair can be moved together.
+    out << "image: " << std::filesystem::path(image_path).filename().string()
+        << "\nmode: trinary\nresolution: " << Shortest(grid.resolution_m) << "\norigin: ["
+        << Shortest(grid.origin_m.x()) << ", " << Shortest(grid.origin_m.y())
+        << ", 0.0]\nnegate: 0\noccupied_thresh: " << Shortest(config.occupied_thresh)
+        << "\nfree_thresh: " << Shortest(config.free_thresh) << "\n";
+  });
+}
+
+double MapServerMap::Occupancy(int column, int image_row) const {
+  const double value =
+      pixels[static_cast<std::size_t>(image_row) * static_cast<std::size_t>(width) +
+             static_cast<std::size_t>(column)];
+  return negate != 0 ? value / 255.0 : (255.0 - value) / 255.0;
+}
+
+MapServerMap ReadMapServerMap(const std::string& yaml_path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml_path);
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error(yaml_path + ": cannot open the map YAML");
+  } catch (const YAML::Exception& error) {
+    Fail(yaml_path, "line " + std::to_string(error.mark.line + 1) + ": " + error.msg);
+  }
+  if (!root.IsMap()) Fail(yaml_path, "not a YAML mapping of map_server keys");
+  MapServerMap map;
+  const auto image = Required<std::string>(root, "image", yaml_path);
+  const std::filesystem::path image_path(image);
+  map.image_path = image_path.is_absolute()
+                       ? image
+                       : (std::filesystem::path(yaml_path).parent_path() / image_path).string();
+  map.resolution_m = Required<double>(root, "resolution", yaml_path);
+  if (!(map.resolution_m > 0.0)) Fail(yaml_path, "resolution must be positive");
+  const auto origin = Required<std::vector<double>>(root, "origin", yaml_path);
+  if (origin.size() != 3) Fail(yaml_path, "origin must be [x, y, yaw]");
+  map.origin_x_m = origin[0];
+  map.origin_y_m = origin[1];
+  map.origin_yaw_rad = origin[2];
+  map.negate = Required<int>(root, "negate", yaml_path);
+  map.occupied_thresh = Required<double>(root, "occupied_thresh", yaml_path);
+  map.free_thresh = Required<double>(root, "free_thresh", yaml_path);
+  if (root["mode"]) map.mode = Required<std::string>(root, "mode", yaml_path);
+  ReadImage(map);
+  return map;
+}
+
+}  // namespace keyplace
