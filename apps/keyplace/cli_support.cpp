@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "io/atomic_file.hpp"
+#include "keyplace/mapping/map_server.hpp"
 
 namespace keyplace::cli {
 
@@ -145,6 +146,37 @@ StageProgress StageProgressBar() {
     (*current)->Update(done);
     if (done == total) (*current)->Finish();
   };
+}
+
+std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path) {
+  if (yaml_path.empty()) return {};
+  return {{"--grid", yaml_path}, {"--grid (its image)", MapServerImagePath(yaml_path)}};
+}
+
+void WriteGrid(const std::string& yaml_path, const OccupancyGrid& grid,
+               const OccupancyGridConfig& config) {
+  WriteMapServerMap(grid, config, yaml_path);
+  fmt::print("occupancy grid written to {} and {} ({} x {} cells of {} m, origin {:.3f} {:.3f})\n",
+             yaml_path, MapServerImagePath(yaml_path), grid.width, grid.height, grid.resolution_m,
+             grid.origin_m.x(), grid.origin_m.y());
+}
+
+void PrintGridAgreement(const GridAgreement& agreement) {
+  fmt::print(
+      "grid vs corrected-pose grid: {:.1f} % of its {} occupied cells within {} m of an occupied "
+      "reference cell, {:.1f} % of the reference's {} matched, {:.2f} % in free reference space\n",
+      100.0 * agreement.occupied_matched, agreement.occupied, agreement.tolerance_m,
+      100.0 * agreement.reference_matched, agreement.occupied_reference,
+      100.0 * agreement.occupied_on_free);
+}
+
+nlohmann::json GridAgreementJson(const GridAgreement& agreement) {
+  return {{"tolerance_m", agreement.tolerance_m},
+          {"occupied", agreement.occupied},
+          {"occupied_reference", agreement.occupied_reference},
+          {"occupied_matched", agreement.occupied_matched},
+          {"reference_matched", agreement.reference_matched},
+          {"occupied_on_free", agreement.occupied_on_free}};
 }
 
 }  // namespace keyplace::cli

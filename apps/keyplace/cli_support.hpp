@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "keyplace/eval/grid_agreement.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 
@@ -54,6 +55,18 @@ ScanRange ParseScanRange(const std::string& text, std::size_t count);
 /// outputs the same file: throws std::invalid_argument naming the option, before any work.
 void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
                   const std::vector<std::string>& inputs);
+
+/// The outputs of --grid FILE.yaml: the YAML and its image (MapServerImagePath), for CheckOutputs;
+/// none when `yaml_path` is empty.
+std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path);
+
+/// Writes `grid` as a map_server map at `yaml_path` and prints where, its size and resolution.
+void WriteGrid(const std::string& yaml_path, const OccupancyGrid& grid,
+               const OccupancyGridConfig& config);
+
+/// One line: how well a grid agrees with the corrected-pose grid (slam --grid --truth).
+void PrintGridAgreement(const GridAgreement& agreement);
+nlohmann::json GridAgreementJson(const GridAgreement& agreement);
 
 /// --scans A:B as the scans [A, B) of the file that PrepareLogInputs keeps (clamped to the log
 /// there); nothing when `text` is empty.

@@ -28,6 +28,7 @@ struct MapOptions {
   std::string json_path;
   std::string png_path;
   std::string svg_path;
+  std::string grid_path;
   std::string scans;
   ConfigOptions config;
   bool overlap_only = false;
@@ -136,11 +137,12 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
 
 void RunMap(const MapOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--out", options.out_path},
-                {"--json", options.json_path},
-                {"--png", options.png_path},
-                {"--svg", options.svg_path}},
-               {options.input});
+  auto outputs = GridOutputs(options.grid_path);
+  outputs.insert(outputs.end(), {{"--out", options.out_path},
+                                 {"--json", options.json_path},
+                                 {"--png", options.png_path},
+                                 {"--svg", options.svg_path}});
+  CheckOutputs(outputs, {options.input});
   const Config config = ResolveConfig(options.config, [&](Config& c) {
     if (options.overlap_only) {
       c.mapping.use_distribution = false;
@@ -161,6 +163,9 @@ void RunMap(const MapOptions& options) {
   result.map.configuration = ConfigToYaml(config);
   if (!options.out_path.empty()) SaveMap(result.map, options.out_path);
   PrintMapReport(options, inputs, result);
+  if (!options.grid_path.empty()) {
+    WriteGrid(options.grid_path, LogOccupancyGrid(inputs, config.grid), config.grid);
+  }
   DrawFigures(options, inputs, result);
   if (!options.json_path.empty()) {
     nlohmann::json json = MapJson(options, inputs, result);
@@ -192,6 +197,9 @@ void RegisterMapCommand(CLI::App& app) {
   command->add_option("--png", options->png_path,
                       "Draw the map (scan points, stable keypoints, submap origins) as PNG");
   command->add_option("--svg", options->svg_path, "Draw the map as SVG");
+  command->add_option("--grid", options->grid_path,
+                      "Write an occupancy grid of the scans at their poses for ROS map_server / "
+                      "nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE)");
   command->add_flag("--overlap-only", options->overlap_only,
                     "Complete submaps on the overlap criterion alone (paper Section 3.1.3, as "
                     "for Table II): no distribution or keypoint-count criterion");

@@ -14,6 +14,7 @@
 #include "config_options.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
+#include "keyplace/localization/initial_pose.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "query_log.hpp"
 #include "relocalize_output.hpp"
@@ -29,6 +30,7 @@ struct RelocalizeOptions {
   std::string tsv_path;
   std::string fixes_path;
   std::string figure_path;
+  std::string initial_pose_path;
   ConfigOptions config;
   int starts = 50;
 };
@@ -47,12 +49,32 @@ RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config&
   return options;
 }
 
+// The first fix of the first start that got one, as the /initialpose message a robot would
+// publish at that moment; a note when no start got a fix (nothing is written).
+void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
+  for (const StartRecord& record : report.records) {
+    for (const FixEvent& fix : record.fixes) {
+      if (!fix.first) continue;
+      InitialPose pose;
+      pose.T_map_robot = fix.T_world_robot_reported;
+      pose.position_variance_m2 = fix.position_variance_m2;
+      pose.heading_variance_rad2 = fix.heading_variance_rad2;
+      WriteInitialPose(pose, path);
+      fmt::print("initial pose (first fix, start at scan {}, fix at scan {}) written to {}\n",
+                 record.start_scan, fix.scan, path);
+      return;
+    }
+  }
+  fmt::print(stderr, "keyplace: note: no start got a fix; {} not written\n", path);
+}
+
 void RunRelocalize(const RelocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CheckOutputs({{"--json", options.json_path},
                 {"--tsv", options.tsv_path},
                 {"--fixes", options.fixes_path},
-                {"--figure", options.figure_path}},
+                {"--figure", options.figure_path},
+                {"--initialpose", options.initial_pose_path}},
                {options.query.log_path, options.query.truth_path, options.query.index_path,
                 options.map_path});
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
@@ -90,6 +112,7 @@ void RunRelocalize(const RelocalizeOptions& options) {
   if (!options.figure_path.empty()) {
     DrawRelocalization(options.figure_path, report, map, inputs, truth);
   }
+  if (!options.initial_pose_path.empty()) WriteFirstFix(options.initial_pose_path, report);
   if (!options.json_path.empty()) {
     nlohmann::json json = RelocalizeJson(report);
     json["config"] = ConfigJson(config);
@@ -132,6 +155,9 @@ void RegisterRelocalizeCommand(CLI::App& app) {
                       "Write one TSV row per fix reported (pose, truth, error) to FILE");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
+  command->add_option("--initialpose", options->initial_pose_path,
+                      "Write the first fix as a geometry_msgs/PoseWithCovarianceStamped for "
+                      "/initialpose (YAML, or JSON for a .json FILE), in the map's frame");
   command->callback(
       [options] { RunOnWorkerThreads(options->query.threads, [&] { RunRelocalize(*options); }); });
 }

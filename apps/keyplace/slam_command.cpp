@@ -35,6 +35,7 @@ struct SlamOptions {
   std::string relations_path;
   std::string json_path;
   std::string loops_path;
+  std::string grid_path;
   std::string figures_dir;
   std::string order = "logger";
   ConfigOptions config;
@@ -62,10 +63,12 @@ void RunSlam(const SlamOptions& options) {
   if (options.truth_path.empty() != options.index_path.empty()) {
     throw std::invalid_argument("--truth and --index must be given together");
   }
-  CheckOutputs({{"--out", options.out_path},
-                {"--trajectory", options.trajectory_path},
-                {"--json", options.json_path},
-                {"--loops", options.loops_path}},
+  auto outputs = GridOutputs(options.grid_path);
+  outputs.insert(outputs.end(), {{"--out", options.out_path},
+                                 {"--trajectory", options.trajectory_path},
+                                 {"--json", options.json_path},
+                                 {"--loops", options.loops_path}});
+  CheckOutputs(outputs,
                {options.input, options.truth_path, options.index_path, options.relations_path});
   const Config config = ResolveConfig(options.config);
   const ProcessingOrder order = ParseProcessingOrder(options.order);
@@ -93,8 +96,20 @@ void RunSlam(const SlamOptions& options) {
     fmt::print("figures written to {}\n", options.figures_dir);
   }
   if (!options.out_path.empty()) fmt::print("map written to {}\n", options.out_path);
+  std::optional<GridAgreement> grid_agreement;
+  if (!options.grid_path.empty()) {
+    const OccupancyGrid grid = SlamOccupancyGrid(run, inputs, config.grid);
+    WriteGrid(options.grid_path, grid, config.grid);
+    if (truth && evaluation.accuracy) {
+      grid_agreement = EvaluateSlamGrid(grid, inputs, *truth, *evaluation.accuracy, config.grid,
+                                        config.evaluation.grid_tolerance_m);
+      PrintGridAgreement(*grid_agreement);
+    }
+  }
   if (!options.json_path.empty()) {
-    WriteJson(options.json_path, SlamJson(report, SecondsSince(start)));
+    nlohmann::json json = SlamJson(report, SecondsSince(start));
+    if (grid_agreement) json["grid_agreement"] = GridAgreementJson(*grid_agreement);
+    WriteJson(options.json_path, json);
   }
 }
 
@@ -114,6 +129,9 @@ void RegisterSlamCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--out", options->out_path, "write the SLAM map (.kpm)");
+  command->add_option("--grid", options->grid_path,
+                      "write an occupancy grid of the scans at the SLAM poses for ROS map_server "
+                      "/ nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE)");
   command->add_option("--trajectory", options->trajectory_path,
                       "write every scan's optimised pose (TSV: scan_index, timestamp, x, y, theta, "
                       "submap, ICP pose)");

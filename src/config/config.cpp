@@ -95,7 +95,9 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
         .Double("give_up_m", &C::give_up_m, "m",
                 "relocalize: a start without a fix is given up after this odometry distance")
         .Double("follow_m", &C::follow_m, "m",
-                "relocalize: fixes are checked over this distance after the first one");
+                "relocalize: fixes are checked over this distance after the first one")
+        .Double("grid_tolerance_m", &C::grid_tolerance_m, "m",
+                "slam --grid: occupied cells agree with the corrected-pose grid within this");
     return table;
   }();
   return fields;
@@ -107,6 +109,9 @@ void Validate(const EvaluationConfig& config) {
   }
   if (config.truth_max_gap_scans < 0) {
     throw std::invalid_argument("EvaluationConfig.truth_max_gap_scans must be >= 0");
+  }
+  if (!(config.grid_tolerance_m >= 0.0 && config.grid_tolerance_m <= 10.0)) {
+    throw std::invalid_argument("EvaluationConfig.grid_tolerance_m must be in [0, 10] m");
   }
   if (!(config.give_up_m > 0.0) || !(config.follow_m >= 0.0)) {
     throw std::invalid_argument(

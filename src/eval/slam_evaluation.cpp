@@ -157,6 +157,19 @@ SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, Processi
   return run;
 }
 
+OccupancyGrid SlamOccupancyGrid(const SlamRun& run, const LogInputs& inputs,
+                                const OccupancyGridConfig& config) {
+  std::vector<const LaserScan*> scans;
+  std::vector<Pose2> T_world_robot;
+  scans.reserve(run.trajectory.size());
+  T_world_robot.reserve(run.trajectory.size());
+  for (const OnlineSlam::ScanPose& pose : run.trajectory) {
+    scans.push_back(&inputs.log.scans.at(static_cast<std::size_t>(pose.scan_index)));
+    T_world_robot.push_back(pose.T_world_robot);
+  }
+  return BuildOccupancyGrid(scans, T_world_robot, config);
+}
+
 SlamEvaluation EvaluateSlam(const SlamRun& run, const GroundTruth* truth,
                             const std::vector<Relation>* relations,
                             const EvaluationConfig& config) {
@@ -190,6 +203,20 @@ SlamEvaluation EvaluateSlam(const SlamRun& run, const GroundTruth* truth,
   }
   if (relations != nullptr) EvaluateRelationsOf(run, *relations, config, ev);
   return ev;
+}
+
+GridAgreement EvaluateSlamGrid(const OccupancyGrid& slam_grid, const LogInputs& inputs,
+                               const GroundTruth& truth, const SlamAccuracy& accuracy,
+                               const OccupancyGridConfig& config, double tolerance_m) {
+  std::vector<const LaserScan*> scans;
+  std::vector<Pose2> T_world_robot;
+  for (std::size_t i = 0; i < inputs.log.scans.size(); ++i) {
+    if (!truth.Has(i)) continue;
+    scans.push_back(&inputs.log.scans[i]);
+    T_world_robot.push_back(truth.Pose(i));
+  }
+  const OccupancyGrid reference = BuildOccupancyGrid(scans, T_world_robot, config);
+  return CompareOccupancyGrids(slam_grid, reference, accuracy.ate.alignment, config, tolerance_m);
 }
 
 }  // namespace keyplace

@@ -158,4 +158,15 @@ LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
   return result;
 }
 
+OccupancyGrid LogOccupancyGrid(const LogInputs& inputs, const OccupancyGridConfig& config) {
+  if (inputs.poses.size() != inputs.log.scans.size()) {
+    throw std::invalid_argument(inputs.source_log +
+                                ": an occupancy grid needs a pose for every scan");
+  }
+  std::vector<const LaserScan*> scans;
+  scans.reserve(inputs.log.scans.size());
+  for (const LogScan& scan : inputs.log.scans) scans.push_back(&scan);
+  return BuildOccupancyGrid(scans, inputs.poses, config);
+}
+
 }  // namespace keyplace

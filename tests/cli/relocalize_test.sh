@@ -13,13 +13,36 @@ log="$source_dir/data/fr079-corrected.log.gz"
 check "relocalize --help" "$keyplace" relocalize --help
 check "map" "$keyplace" map "$log" --out "$work/map.kpm"
 check "relocalize (a)" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" --starts 12 \
-  --threads 2 --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png"
+  --threads 2 --json "$work/a.json" --tsv "$work/a.tsv" --figure "$work/a.png" \
+  --fixes "$work/a_fixes.tsv" --initialpose "$work/fix.json"
 # The starts run in parallel: one thread gives the same figures and rows, times aside.
 check "relocalize (a), 1 thread" "$keyplace" relocalize --map "$work/map.kpm" --log "$log" \
-  --starts 12 --threads 1 --json "$work/a1.json" --tsv "$work/a1.tsv"
+  --starts 12 --threads 1 --json "$work/a1.json" --tsv "$work/a1.tsv" \
+  --initialpose "$work/fix.yaml"
 check "same JSON at 1 and 2 threads" same_figures "$work/a1.json" "$work/a.json"
 check "same TSV at 1 and 2 threads" same_figures "$work/a1.tsv" "$work/a.tsv"
 check "figure" test -s "$work/a.png"
+# --initialpose: the first fix of the first start that got one, as a PoseWithCovarianceStamped
+# (issue 16), the same in JSON and YAML, at that fix's pose and near its truth.
+check "initial pose" /usr/bin/python3 -c "
+import csv, json, math, sys
+message = json.load(open(sys.argv[1]))
+assert message['header']['frame_id'] == 'map', message
+pose = message['pose']['pose']
+q = pose['orientation']
+assert abs(q['x']) == 0 and abs(q['y']) == 0 and abs(q['z']**2 + q['w']**2 - 1) < 1e-9, q
+covariance = message['pose']['covariance']
+assert len(covariance) == 36 and covariance[0] > 0 and covariance[0] == covariance[7], covariance
+assert covariance[35] > 0 and sum(map(abs, covariance)) == covariance[0] * 2 + covariance[35]
+first = [r for r in csv.DictReader(open(sys.argv[2]), delimiter='	') if r['first'] == '1'][0]
+x, y = pose['position']['x'], pose['position']['y']
+theta = 2 * math.atan2(q['z'], q['w'])
+assert abs(x - float(first['est_x'])) < 2e-3 and abs(y - float(first['est_y'])) < 2e-3, (x, first)
+assert math.hypot(x - float(first['true_x']), y - float(first['true_y'])) < 0.5, (x, y, first)
+yaml = open(sys.argv[3]).read()
+assert 'frame_id: map' in yaml and 'covariance: [' in yaml, yaml
+assert repr(x) in yaml or ('x: %r' % x) in yaml, (x, yaml)
+" "$work/fix.json" "$work/a_fixes.tsv" "$work/fix.yaml"
 check "TSV: one row per start" test "$(($(wc -l <"$work/a.tsv") - 1))" = 12
 check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_fix_m' \
   "$work/a.tsv"

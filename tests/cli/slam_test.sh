@@ -27,7 +27,7 @@ check "slam --help" "$keyplace" slam --help
 check "slam" "$keyplace" slam "$raw" --out "$work/map.kpm" --trajectory "$work/traj.tsv" \
   --truth "$shared/data/fr079-corrected.log.gz" --index "$work/index.tsv" \
   --relations "$shared/data/fr079.relations" --json "$work/slam.json" --loops "$work/loops.tsv" \
-  --figures "$work/figures"
+  --figures "$work/figures" --grid "$work/grid.yaml"
 for key in loops_detected loops_used precision_overlap_10 precision_overlap_30 \
            precision_overlap_30_common_area ate_rmse_m relations.translation_mean_m \
            relations.rotation_mean_deg submaps compression; do
@@ -57,6 +57,28 @@ for figure in trajectory overlap_histogram overlap_histogram_common_area rpe ate
   check "figure $figure" test -s "$work/figures/$figure.png"
 done
 check "map readable" "$keyplace" info "$work/map.kpm"
+# The occupancy grid for map_server (issue 16), checked against the corrected-pose grid.
+check "grid files" python3 -c "
+import json,sys,os
+work = sys.argv[1]
+yaml = open(work + '/grid.yaml').read()
+assert 'image: grid.pgm' in yaml and 'resolution: 0.05' in yaml and 'mode: trinary' in yaml, yaml
+pgm = open(work + '/grid.pgm', 'rb').read()
+header = pgm.split(b'\\n', 3)
+assert header[0] == b'P5', header[:3]
+width, height = map(int, header[2].split())
+assert len(header[3]) == len(b'255\\n') + width * height, (len(header[3]), width, height)
+pixels = set(header[3][4:])
+assert pixels <= {0, 205, 254} and {0, 254} <= pixels, pixels
+g = json.load(open(work + '/slam.json'))['grid_agreement']
+assert g['tolerance_m'] == 0.1 and g['occupied'] > 1000 and g['occupied_reference'] > 1000, g
+assert g['occupied_matched'] > 0.85 and g['reference_matched'] > 0.85, g
+assert g['occupied_on_free'] < 0.05, g
+" "$work"
+fails_with "--grid equal to --out" "--grid" "$keyplace" slam "$raw" --out "$work/same.yaml" \
+  --grid "$work/same.yaml"
+fails_with "grid config checked" "grid.free_thresh" "$keyplace" slam "$raw" \
+  --grid "$work/bad.yaml" --set grid.free_thresh=0.9
 
 # Bad input names the file and the line; an existing output is left as it was.
 cp "$work/slam.json" "$work/slam.before.json"

@@ -28,7 +28,7 @@ struct Config {
                                  // odometry, mapping and place are the sections above
   LocalizerConfig localization;  // streaming localizer; its place is the section above
   EvaluationConfig evaluation;   // evaluation settings (not the method's)
-  OccupancyGridConfig grid;      // occupancy grids for navigation stacks (docs/ROS.md)
+  OccupancyGridConfig grid;      // occupancy grids for navigation stacks (docs/NAVIGATION.md)
 };
 
 /// The SLAM configuration with the odometry, mapping and place sections put in.

@@ -20,6 +20,9 @@ struct EvaluationConfig {
   // after its first fix the fixes are checked over this further distance.
   double give_up_m = 50.0;
   double follow_m = 20.0;
+  // keyplace slam --grid with --truth: an occupied cell agrees with the reference grid when an
+  // occupied reference cell lies within this (two cells of the default grid).
+  double grid_tolerance_m = 0.1;
 };
 
 /// Throws std::invalid_argument naming the first invalid field.

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "keyplace/eval/evaluation_config.hpp"
+#include "keyplace/eval/grid_agreement.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/loop_overlap.hpp"
 #include "keyplace/eval/relation_error.hpp"
@@ -58,6 +59,11 @@ struct SlamRun {
 /// the inputs hold no keypoints for their scans.
 SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, ProcessingOrder order,
                      const ProgressCallback& progress = {});
+
+/// The occupancy grid of the scans of `inputs` at the SLAM trajectory's final poses (`run` made
+/// from `inputs`). Throws std::invalid_argument as BuildOccupancyGrid.
+OccupancyGrid SlamOccupancyGrid(const SlamRun& run, const LogInputs& inputs,
+                                const OccupancyGridConfig& config);
 
 /// Loop precisions: the share of detected loops whose overlap is at least 10 % / 30 %.
 struct LoopPrecisions {
@@ -113,5 +119,11 @@ struct SlamEvaluation {
 SlamEvaluation EvaluateSlam(const SlamRun& run, const GroundTruth* truth,
                             const std::vector<Relation>* relations,
                             const EvaluationConfig& config = {});
+
+/// The SLAM grid against the reference grid of the scans of `inputs` that have a truth pose, at
+/// those poses, through the ATE alignment of `accuracy` (docs/NAVIGATION.md, "Checking the grid").
+GridAgreement EvaluateSlamGrid(const OccupancyGrid& slam_grid, const LogInputs& inputs,
+                               const GroundTruth& truth, const SlamAccuracy& accuracy,
+                               const OccupancyGridConfig& config, double tolerance_m);
 
 }  // namespace keyplace

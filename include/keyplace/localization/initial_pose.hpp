@@ -1,6 +1,6 @@
 #pragma once
 // A fix as a ROS geometry_msgs/PoseWithCovarianceStamped, ready to publish on /initialpose for
-// AMCL or nav2 (docs/ROS.md): `rostopic pub -f fix.yaml /initialpose
+// AMCL or nav2 (docs/NAVIGATION.md): `rostopic pub -f fix.yaml /initialpose
 // geometry_msgs/PoseWithCovarianceStamped`, or the same fields in JSON.
 
 #include <string>

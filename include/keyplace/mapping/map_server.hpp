@@ -1,7 +1,7 @@
 #pragma once
 // Occupancy grids in the ROS map_server format: a binary PGM image and a YAML file naming it,
 // with its resolution, origin and thresholds, as map_server (ROS 1) and nav2_map_server load them
-// (docs/ROS.md).
+// (docs/NAVIGATION.md).
 
 #include <cstdint>
 #include <string>

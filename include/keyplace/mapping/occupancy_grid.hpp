@@ -1,7 +1,7 @@
 #pragma once
 // A global occupancy grid from scans at known poses (corrected, or a SLAM trajectory): what a
 // navigation stack (ROS map_server, nav2/AMCL, move_base) loads as its map. Each beam marks the
-// cells it crosses as free and the cell it ends in as occupied, in log-odds (docs/ROS.md).
+// cells it crosses as free and the cell it ends in as occupied, in log-odds (docs/NAVIGATION.md).
 
 #include <cstddef>
 #include <cstdint>

@@ -13,6 +13,7 @@
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
+#include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/registration/scan_odometry.hpp"
 
 namespace keyplace {
@@ -80,6 +81,10 @@ struct LogInputs {
 /// computes the poses and the keypoints. `progress` may be empty.
 LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options = {},
                            const StageProgress& progress = {});
+
+/// The occupancy grid of the inputs' scans at their poses (inputs.poses, which must be computed).
+/// Throws std::invalid_argument as BuildOccupancyGrid, or when the poses were not computed.
+OccupancyGrid LogOccupancyGrid(const LogInputs& inputs, const OccupancyGridConfig& config);
 
 /// A log's global map (Algorithm 2) with its provenance and the mapping criteria of Section 5.1.
 struct LogMap {
