@@ -13,6 +13,7 @@ void RegisterMapCommand(CLI::App& app);
 void RegisterLocalizeCommand(CLI::App& app);
 void RegisterRelocalizeCommand(CLI::App& app);
 void RegisterSlamCommand(CLI::App& app);
+void RegisterMergeCommand(CLI::App& app);
 void RegisterSweepCommand(CLI::App& app);
 void RegisterReportCommand(CLI::App& app);
 void RegisterDumpConfigCommand(CLI::App& app);

@@ -24,6 +24,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterLocalizeCommand(app);
   keyplace::cli::RegisterRelocalizeCommand(app);
   keyplace::cli::RegisterSlamCommand(app);
+  keyplace::cli::RegisterMergeCommand(app);
   keyplace::cli::RegisterSweepCommand(app);
   keyplace::cli::RegisterReportCommand(app);
   keyplace::cli::RegisterDumpConfigCommand(app);

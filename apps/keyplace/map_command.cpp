@@ -33,6 +33,7 @@ struct MapOptions {
   ConfigOptions config;
   bool overlap_only = false;
   bool skip_bad_lines = false;
+  bool start_at_origin = false;
   int threads = 0;
 };
 
@@ -153,6 +154,7 @@ void RunMap(const MapOptions& options) {
   input_options.reading.skip_bad_lines = options.skip_bad_lines;
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
+  input_options.start_at_origin = options.start_at_origin;
   input_options.features = config.features;
   ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
@@ -207,6 +209,9 @@ void RegisterMapCommand(CLI::App& app) {
                       "Map only the scans A:B of the log (e.g. 0:700, the first part of a "
                       "time split); the map's scan indices stay those of the whole file");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
+  command->add_flag("--start-at-origin", options->start_at_origin,
+                    "Express the map in the frame of its first scan's pose, as a robot's own "
+                    "frame of one session (for keyplace merge)");
   AddConfigOptions(command, options->config);
   command
       ->add_option("--threads", options->threads,

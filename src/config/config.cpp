@@ -19,7 +19,8 @@ const ConfigFields<Config>& ConfigTable() {
         .Nested("slam", &Config::slam, SlamConfigFields())
         .Nested("localization", &Config::localization, LocalizerConfigFields())
         .Nested("evaluation", &Config::evaluation, EvaluationConfigFields())
-        .Nested("grid", &Config::grid, OccupancyGridConfigFields());
+        .Nested("grid", &Config::grid, OccupancyGridConfigFields())
+        .Nested("merge", &Config::merge, MergeOptionsFields());
     return table;
   }();
   return fields;
@@ -36,6 +37,7 @@ void ValidateSection(const std::string& key, const Config& config) {
   if (section == "localization") Validate(ToLocalizerConfig(config));
   if (section == "evaluation") Validate(config.evaluation);
   if (section == "grid") Validate(config.grid);
+  if (section == "merge") Validate(config.merge);
 }
 
 }  // namespace
@@ -156,6 +158,7 @@ void Validate(const Config& config) {
   Validate(ToLocalizerConfig(config));
   Validate(config.evaluation);
   Validate(config.grid);
+  Validate(config.merge);
 }
 
 std::vector<ConfigFieldInfo> DescribeConfig(const Config& config) {

@@ -6,6 +6,7 @@
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/localization/map_merge.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -29,5 +30,6 @@ const ConfigFields<SlamConfig>& SlamConfigFields();
 const ConfigFields<LocalizerConfig>& LocalizerConfigFields();
 const ConfigFields<EvaluationConfig>& EvaluationConfigFields();
 const ConfigFields<OccupancyGridConfig>& OccupancyGridConfigFields();
+const ConfigFields<MergeOptions>& MergeOptionsFields();
 
 }  // namespace keyplace

@@ -110,6 +110,10 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
                              [&](std::size_t done, std::size_t total) {
                                if (progress) progress(pose_stage, done, total);
                              });
+    if (options.start_at_origin) {
+      const Pose2 T_first_world = inputs.poses.front().inverse();
+      for (Pose2& pose : inputs.poses) pose = T_first_world * pose;
+    }
     inputs.seconds_poses = SecondsSince(start);
   }
 

@@ -11,6 +11,7 @@
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/localization/map_merge.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -29,6 +30,7 @@ struct Config {
   LocalizerConfig localization;  // streaming localizer; its place is the section above
   EvaluationConfig evaluation;   // evaluation settings (not the method's)
   OccupancyGridConfig grid;      // occupancy grids for navigation stacks (docs/NAVIGATION.md)
+  MergeOptions merge;            // keyplace merge (docs/MERGE.md)
 };
 
 /// The SLAM configuration with the odometry, mapping and place sections put in.

@@ -56,6 +56,9 @@ struct LogInputOptions {
   bool keypoints = true;  // false: leave LogInputs::keypoints empty
   // false: leave LogInputs::poses empty, for callers that estimate the poses themselves (SLAM)
   bool compute_poses = true;
+  // true: the poses are expressed in the frame of the first kept scan's pose, as a robot whose
+  // own frame starts where the session starts (a map of one session of a multi-session set).
+  bool start_at_origin = false;
 };
 
 /// Progress of a preparation stage ("poses (icp)", "keypoints"): (stage, done, total).
