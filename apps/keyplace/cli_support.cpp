@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -150,6 +151,11 @@ StageProgress StageProgressBar() {
 
 std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path) {
   if (yaml_path.empty()) return {};
+  const std::string extension = std::filesystem::path(yaml_path).extension().string();
+  if (extension != ".yaml" && extension != ".yml") {
+    throw std::invalid_argument("--grid " + yaml_path +
+                                ": expected a .yaml file (its image goes beside it as .pgm)");
+  }
   return {{"--grid", yaml_path}, {"--grid (its image)", MapServerImagePath(yaml_path)}};
 }
 

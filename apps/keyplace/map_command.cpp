@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -163,11 +164,13 @@ void RunMap(const MapOptions& options) {
   LogMap result = MapLog(inputs, config.mapping, [&](std::size_t next) { progress.Update(next); });
   progress.Finish();
   result.map.configuration = ConfigToYaml(config);
+  // Built before anything is written: a grid that cannot be made (grid.max_cells) leaves no
+  // output of this run behind.
+  std::optional<OccupancyGrid> grid;
+  if (!options.grid_path.empty()) grid = LogOccupancyGrid(inputs, config.grid);
   if (!options.out_path.empty()) SaveMap(result.map, options.out_path);
   PrintMapReport(options, inputs, result);
-  if (!options.grid_path.empty()) {
-    WriteGrid(options.grid_path, LogOccupancyGrid(inputs, config.grid), config.grid);
-  }
+  if (grid) WriteGrid(options.grid_path, *grid, config.grid);
   DrawFigures(options, inputs, result);
   if (!options.json_path.empty()) {
     nlohmann::json json = MapJson(options, inputs, result);

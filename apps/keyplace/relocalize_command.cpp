@@ -16,6 +16,7 @@
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/localization/initial_pose.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "localize_output.hpp"
 #include "query_log.hpp"
 #include "relocalize_output.hpp"
 
@@ -56,7 +57,7 @@ void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
     for (const FixEvent& fix : record.fixes) {
       if (!fix.first) continue;
       InitialPose pose;
-      pose.T_map_robot = fix.T_world_robot_reported;
+      pose.T_map_robot = fix.T_world_robot_at_fix;
       pose.position_variance_m2 = fix.position_variance_m2;
       pose.heading_variance_rad2 = fix.heading_variance_rad2;
       WriteInitialPose(pose, path);
@@ -92,6 +93,10 @@ void RunRelocalize(const RelocalizeOptions& options) {
   report.end_scan = inputs.first_scan + inputs.log.scans.size();
   report.pose_source = inputs.pose_source;
   report.query_log_is_map_log = TruthIsMapLog(map, truth);
+  WarnAboutMapSource(
+      options.map_path, map,
+      options.query.truth_path.empty() ? options.query.log_path : options.query.truth_path,
+      report.query_log_is_map_log);
   report.options = BenchmarkOptions(options, config, report.query_log_is_map_log);
   report.seconds_keypoints_per_scan =
       inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());

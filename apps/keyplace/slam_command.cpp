@@ -83,6 +83,10 @@ void RunSlam(const SlamOptions& options) {
   if (!options.relations_path.empty()) relations = ReadRelations(options.relations_path);
 
   const SlamRun run = Run(inputs, config, order);
+  // Built before anything is written: a grid that cannot be made (grid.max_cells) leaves no
+  // output of this run behind.
+  std::optional<OccupancyGrid> grid;
+  if (!options.grid_path.empty()) grid = SlamOccupancyGrid(run, inputs, config.grid);
   if (!options.out_path.empty()) SaveMap(run.map, options.out_path);
   if (!options.trajectory_path.empty()) WriteTrajectoryTsv(options.trajectory_path, run);
   const SlamEvaluation evaluation = EvaluateSlam(
@@ -97,11 +101,10 @@ void RunSlam(const SlamOptions& options) {
   }
   if (!options.out_path.empty()) fmt::print("map written to {}\n", options.out_path);
   std::optional<GridAgreement> grid_agreement;
-  if (!options.grid_path.empty()) {
-    const OccupancyGrid grid = SlamOccupancyGrid(run, inputs, config.grid);
-    WriteGrid(options.grid_path, grid, config.grid);
+  if (grid) {
+    WriteGrid(options.grid_path, *grid, config.grid);
     if (truth && evaluation.accuracy) {
-      grid_agreement = EvaluateSlamGrid(grid, inputs, *truth, *evaluation.accuracy, config.grid,
+      grid_agreement = EvaluateSlamGrid(*grid, inputs, *truth, *evaluation.accuracy, config.grid,
                                         config.evaluation.grid_tolerance_m);
       PrintGridAgreement(*grid_agreement);
     }
@@ -131,7 +134,8 @@ void RegisterSlamCommand(CLI::App& app) {
   command->add_option("--out", options->out_path, "write the SLAM map (.kpm)");
   command->add_option("--grid", options->grid_path,
                       "write an occupancy grid of the scans at the SLAM poses for ROS map_server "
-                      "/ nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE)");
+                      "/ nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE); with "
+                      "--truth it is checked against the grid at the corrected poses");
   command->add_option("--trajectory", options->trajectory_path,
                       "write every scan's optimised pose (TSV: scan_index, timestamp, x, y, theta, "
                       "submap, ICP pose)");

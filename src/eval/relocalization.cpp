@@ -169,7 +169,7 @@ class StartRun {
     fix.T_world_robot = update.T_world_odom * inputs_.poses[*checked];
     fix.truth = truth_.Pose(*checked);
     fix.confidence = update.confidence;
-    fix.T_world_robot_reported = update.T_world_robot;
+    fix.T_world_robot_at_fix = update.T_world_robot;
     fix.position_variance_m2 = update.position_variance_m2;
     fix.heading_variance_rad2 = update.heading_variance_rad2;
     fix.correct = Within(fix.T_world_robot, fix.truth, options_.correct_m, options_.correct_deg);

@@ -735,15 +735,15 @@ void ReadLines(const std::string& path, LineReader& reader, ReaderState& state,
 }
 
 // What a reader out of memory says instead of a bare std::bad_alloc: where it was and how much
-// it held, so the user knows the log itself is too large for this machine.
-std::string OutOfMemoryText(const std::string& path, std::size_t line_number,
-                            const ReaderState& state) {
-  const CarmenLog& log = state.log;
-  const std::size_t beams = state.options.keep_beams ? log.beams_total : 0;
-  const std::size_t held_mib =
-      (beams * kBytesPerHeldBeam + log.scans.size() * sizeof(LogScan)) >> 20U;
+// it held, so the user knows the log itself is too large for this machine. The scans are
+// released first: the message itself needs memory.
+std::string OutOfMemoryText(const std::string& path, std::size_t line_number, ReaderState& state) {
+  const std::size_t scans = state.log.scans.size();
+  const std::size_t beams = state.options.keep_beams ? state.log.beams_total : 0;
+  std::vector<LogScan>().swap(state.log.scans);
+  const std::size_t held_mib = (beams * kBytesPerHeldBeam + scans * sizeof(LogScan)) >> 20U;
   return path + ":" + std::to_string(line_number) + ": out of memory after reading " +
-         std::to_string(log.scans.size()) + " scans (about " + std::to_string(held_mib) +
+         std::to_string(scans) + " scans (about " + std::to_string(held_mib) +
          " MiB held: the whole log is kept in memory, " + std::to_string(kBytesPerHeldBeam) +
          " bytes per beam); split the log or use a machine with more memory";
 }

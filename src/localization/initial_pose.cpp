@@ -1,6 +1,8 @@
 #include "keyplace/localization/initial_pose.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -34,8 +36,22 @@ bool EndsWith(const std::string& text, const std::string& suffix) {
          text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// A frame id as ROS names them (letters, digits, '_', '/', '.', '-'): written as is in YAML and
+// JSON, so anything else is refused rather than escaped.
+void CheckFrameId(const std::string& frame_id) {
+  const bool valid = !frame_id.empty() && std::all_of(frame_id.begin(), frame_id.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '/' || c == '.' ||
+           c == '-';
+  });
+  if (!valid) {
+    throw std::invalid_argument("initial pose: frame id '" + frame_id +
+                                "' is not a ROS frame name (letters, digits, _ / . -)");
+  }
+}
+
 // The message's fields in the flow style both YAML and (with quoted keys) JSON take.
 std::string MessageText(const InitialPose& pose, bool json) {
+  CheckFrameId(pose.frame_id);
   const auto key = [json](const char* name) {
     return json ? "\"" + std::string(name) + "\": " : std::string(name) + ": ";
   };

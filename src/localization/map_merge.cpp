@@ -12,10 +12,11 @@ namespace keyplace {
 namespace {
 
 constexpr double kRadPerDegree = M_PI / 180.0;
+constexpr int kIdBlock = 1000;
 
 struct Candidate {
   SubmapRecognition recognition;
-  Pose2 origin_b;  // the recognised B submap's origin in B's frame
+  Pose2 T_b_submap;  // the recognised B submap's origin in B's frame
 };
 
 std::vector<Candidate> RecogniseSubmaps(const GlobalMap& a, const GlobalMap& b,
@@ -38,15 +39,15 @@ std::vector<Candidate> RecogniseSubmaps(const GlobalMap& a, const GlobalMap& b,
     candidate.recognition.submap_a = match.place_id;
     candidate.recognition.confidence = match.confidence;
     candidate.recognition.T_a_b = T_a_bsubmap * query_place.T_world_place.inverse();
-    candidate.origin_b = query_place.T_world_place;
+    candidate.T_b_submap = query_place.T_world_place;
     candidates.push_back(candidate);
   }
   return candidates;
 }
 
 bool Agree(const Candidate& x, const Candidate& y, const MergeOptions& options) {
-  const Pose2 in_x = x.recognition.T_a_b * y.origin_b;
-  const Pose2 in_y = y.recognition.T_a_b * y.origin_b;
+  const Pose2 in_x = x.recognition.T_a_b * y.T_b_submap;
+  const Pose2 in_y = y.recognition.T_a_b * y.T_b_submap;
   return std::hypot(in_x.x - in_y.x, in_x.y - in_y.y) <= options.agree_m &&
          std::abs(WrapAngle(in_x.theta - in_y.theta)) <= options.agree_deg * kRadPerDegree;
 }
@@ -77,14 +78,14 @@ Pose2 FitTransform(const std::vector<Candidate>& candidates,
     const Candidate& candidate = candidates[k];
     sin_sum += std::sin(candidate.recognition.T_a_b.theta);
     cos_sum += std::cos(candidate.recognition.T_a_b.theta);
-    origins_b += candidate.origin_b.translation();
-    origins_a += (candidate.recognition.T_a_b * candidate.origin_b).translation();
+    origins_b += candidate.T_b_submap.translation();
+    origins_a += (candidate.recognition.T_a_b * candidate.T_b_submap).translation();
   }
   const double count = static_cast<double>(group.size());
-  const Pose2 rotation(0.0, 0.0, std::atan2(sin_sum, cos_sum));
+  const Pose2 T_rotation(0.0, 0.0, std::atan2(sin_sum, cos_sum));
   const Eigen::Vector2d translation =
-      origins_a / count - rotation * Eigen::Vector2d(origins_b / count);
-  return {translation.x(), translation.y(), rotation.theta};
+      origins_a / count - T_rotation * Eigen::Vector2d(origins_b / count);
+  return {translation.x(), translation.y(), T_rotation.theta};
 }
 
 GlobalMap Joined(const GlobalMap& a, const GlobalMap& b_in_a) {
@@ -105,7 +106,9 @@ GlobalMap Joined(const GlobalMap& a, const GlobalMap& b_in_a) {
       for (const int scan : submap.scan_indices) first_scan = std::min(first_scan, scan);
     }
   }
-  const int id_offset = last_id + 2 - first_id;  // the gap: no B submap neighbours an A submap
+  // B's ids start at the second thousand after A's: a gap wider than any verification reach
+  // (place.verification_neighbours), so no B submap is ever a map neighbour of an A submap.
+  const int id_offset = (last_id / kIdBlock + 2) * kIdBlock - first_id;
   const int scan_offset = last_scan + 1 - first_scan;
   for (Submap submap : b_in_a.submaps) {
     submap.id += id_offset;
@@ -134,10 +137,15 @@ GlobalMap MovedMap(const GlobalMap& map, const Pose2& T_new_old) {
 MergeResult MergeMaps(const GlobalMap& a, const GlobalMap& b, const PlaceRecognitionConfig& place,
                       const MergeOptions& options) {
   Validate(options);
-  if (ToKeyValues(a.config) != ToKeyValues(b.config)) {
-    throw std::invalid_argument(
-        "the maps were made with different mapping settings (see keyplace info): their "
-        "keypoints cannot be compared");
+  const auto settings_a = ToKeyValues(a.config);
+  const auto settings_b = ToKeyValues(b.config);
+  for (std::size_t k = 0; k < settings_a.size(); ++k) {
+    if (settings_a[k] != settings_b[k]) {
+      throw std::invalid_argument("the maps were made with different mapping settings (mapping." +
+                                  settings_a[k].first + " = " + settings_a[k].second + " for " +
+                                  a.source_log + ", " + settings_b[k].second + " for " +
+                                  b.source_log + "): their keypoints cannot be compared");
+    }
   }
   MergeResult result;
   std::vector<Candidate> candidates = RecogniseSubmaps(a, b, place, result.queried);

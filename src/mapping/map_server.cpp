@@ -13,16 +13,20 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/config_fields.hpp"
 #include "io/atomic_file.hpp"
 
 namespace keyplace {
 namespace {
 
-// The shortest text that reads back as the same double.
-std::string Shortest(double value) {
-  std::array<char, 32> text{};
-  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
-  return {text.data(), result.ptr};
+// A YAML double-quoted scalar: a file name may hold ':' or '#'.
+std::string DoubleQuoted(const std::string& text) {
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') quoted.push_back('\\');
+    quoted.push_back(c);
+  }
+  return quoted + "\"";
 }
 
 std::uint8_t PixelOf(CellState state) {
@@ -134,11 +138,11 @@ void WriteMapServerMap(const OccupancyGrid& grid, const OccupancyGridConfig& con
   WriteImage(grid, config, image_path);
   WriteFileAtomically(yaml_path, [&](std::ostream& out) {
     // The image is named relative to the YAML, so the pair can be moved together.
-    out << "image: " << std::filesystem::path(image_path).filename().string()
-        << "\nmode: trinary\nresolution: " << Shortest(grid.resolution_m) << "\norigin: ["
-        << Shortest(grid.origin_m.x()) << ", " << Shortest(grid.origin_m.y())
-        << ", 0.0]\nnegate: 0\noccupied_thresh: " << Shortest(config.occupied_thresh)
-        << "\nfree_thresh: " << Shortest(config.free_thresh) << "\n";
+    out << "image: " << DoubleQuoted(std::filesystem::path(image_path).filename().string())
+        << "\nmode: trinary\nresolution: " << FormatConfigDouble(grid.resolution_m) << "\norigin: ["
+        << FormatConfigDouble(grid.origin_m.x()) << ", " << FormatConfigDouble(grid.origin_m.y())
+        << ", 0.0]\nnegate: 0\noccupied_thresh: " << FormatConfigDouble(kMapServerOccupiedThresh)
+        << "\nfree_thresh: " << FormatConfigDouble(kMapServerFreeThresh) << "\n";
   });
 }
 

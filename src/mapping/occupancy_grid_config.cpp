@@ -53,8 +53,8 @@ const ConfigFields<OccupancyGridConfig>& OccupancyGridConfigFields() {
         .Double("min_probability", &C::min_probability, "", "log-odds clamped below at this")
         .Double("max_probability", &C::max_probability, "", "log-odds clamped above at this")
         .Double("occupied_thresh", &C::occupied_thresh, "",
-                "map_server: occupied at or above this probability")
-        .Double("free_thresh", &C::free_thresh, "", "map_server: free at or below this probability")
+                "a cell at or above this probability is occupied in the image")
+        .Double("free_thresh", &C::free_thresh, "", "a cell at or below this is free in the image")
         .Double("max_trace_range_m", &C::max_trace_range_m, "m",
                 "beams are traced this far at most")
         .Int("max_cells", &C::max_cells, "", "a larger grid is an error (raise resolution_m)");

@@ -110,6 +110,7 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
                              [&](std::size_t done, std::size_t total) {
                                if (progress) progress(pose_stage, done, total);
                              });
+    inputs.start_at_origin = options.start_at_origin;
     if (options.start_at_origin) {
       const Pose2 T_first_world = inputs.poses.front().inverse();
       for (Pose2& pose : inputs.poses) pose = T_first_world * pose;
@@ -146,7 +147,10 @@ LogMap MapLog(const LogInputs& inputs, const MappingConfig& config,
   }
   result.map.source_log = inputs.source_log;
   result.map.source_hash = inputs.source_hash;
-  result.map.pose_source = ToString(inputs.pose_source);
+  // A map in its first scan's frame is not in its log's frame: say so wherever it is read, so
+  // that the log's own poses are not taken for its truth without a word.
+  result.map.pose_source =
+      ToString(inputs.pose_source) + (inputs.start_at_origin ? " (first-scan frame)" : "");
   result.stats = ComputeStats(result.map);
   const std::vector<double>& seconds = result.timings.submap_seconds;
   if (!seconds.empty()) {

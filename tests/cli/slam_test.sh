@@ -62,7 +62,7 @@ check "grid files" python3 -c "
 import json,sys,os
 work = sys.argv[1]
 yaml = open(work + '/grid.yaml').read()
-assert 'image: grid.pgm' in yaml and 'resolution: 0.05' in yaml and 'mode: trinary' in yaml, yaml
+assert 'image: \"grid.pgm\"' in yaml and 'resolution: 0.05' in yaml and 'mode: trinary' in yaml, yaml
 pgm = open(work + '/grid.pgm', 'rb').read()
 header = pgm.split(b'\\n', 3)
 assert header[0] == b'P5', header[:3]

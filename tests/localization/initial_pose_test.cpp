@@ -93,6 +93,16 @@ TEST(InitialPose, YamlAndJsonCarryThePoseQuaternionAndCovariance) {
   EXPECT_NE(text.find("\"frame_id\": \"map\""), std::string::npos) << text;
 }
 
+TEST(InitialPose, AFrameIdThatIsNoRosNameIsRefused) {
+  FixFilter filter = FixedFilter(FixPolicy{});
+  InitialPose pose = InitialPoseOf(filter.Update(std::nullopt, Odometry(7)), "map");
+  pose.frame_id = "map\", x: 1";
+  EXPECT_THROW(InitialPoseYaml(pose), std::invalid_argument);
+  EXPECT_THROW(InitialPoseJson(pose), std::invalid_argument);
+  pose.frame_id = "robot_1/map";
+  EXPECT_NO_THROW(InitialPoseYaml(pose));
+}
+
 TEST(InitialPose, NoFixNoInitialPose) {
   FixFilter filter;
   const RelocalizationUpdate searching = filter.Update(Answer(kTrue), Odometry(0));

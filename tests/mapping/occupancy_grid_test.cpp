@@ -196,6 +196,35 @@ TEST(OccupancyGrid, MapServerFilesPutEveryCellWhereMapServerReadsIt) {
   EXPECT_FALSE(unknown > map.occupied_thresh || unknown < map.free_thresh);
 }
 
+// The grid's own thresholds choose each cell's pixel; the YAML keeps the thresholds that decode
+// the pixels as written. With free_thresh 0.25 in the YAML, map_server would read every unknown
+// pixel (0.196) as free.
+TEST(OccupancyGrid, TheYamlDecodesThePixelsWhateverTheGridThresholds) {
+  const Room room = ScannedRoom();
+  OccupancyGridConfig config;
+  config.free_thresh = 0.25;
+  config.occupied_thresh = 0.6;
+  const OccupancyGrid grid = BuildOccupancyGrid(room.Pointers(), room.T_world_robot, config);
+  const std::string yaml = testing::MakeTempDir("grid") + "/thresholds.yaml";
+  WriteMapServerMap(grid, config, yaml);
+  const MapServerMap map = ReadMapServerMap(yaml);
+  EXPECT_DOUBLE_EQ(map.free_thresh, kMapServerFreeThresh);
+  EXPECT_DOUBLE_EQ(map.occupied_thresh, kMapServerOccupiedThresh);
+  std::size_t unknown = 0;
+  for (int row = 0; row < map.height; ++row) {
+    for (int column = 0; column < map.width; ++column) {
+      const double occupancy = map.Occupancy(column, row);
+      const bool free = occupancy < map.free_thresh;
+      const bool occupied = occupancy > map.occupied_thresh;
+      const CellState state = grid.State(column, map.height - 1 - row, config);
+      EXPECT_EQ(free, state == CellState::kFree) << column << ", " << row;
+      EXPECT_EQ(occupied, state == CellState::kOccupied) << column << ", " << row;
+      unknown += state == CellState::kUnknown;
+    }
+  }
+  EXPECT_GT(unknown, 0U);  // the pillar's inside at least
+}
+
 TEST(OccupancyGrid, AGlitchOfKilometresIsAnErrorNotAGigabyteGrid) {
   Room room = ScannedRoom();
   room.T_world_robot[1] = Pose2(5000.0, 5000.0, 1.4);
@@ -207,13 +236,18 @@ TEST(OccupancyGrid, AGlitchOfKilometresIsAnErrorNotAGigabyteGrid) {
   }
   room.T_world_robot.pop_back();
   EXPECT_THROW(BuildOccupancyGrid(room.Pointers(), room.T_world_robot, OccupancyGridConfig{}),
-               std::invalid_argument);  // 3 scans, 2 poses
+               std::invalid_argument);  // 12 scans, 11 poses
 }
 
 TEST(OccupancyGrid, InvalidConfigsAreRefusedByName) {
   OccupancyGridConfig config;
   config.free_thresh = 0.7;
-  EXPECT_THROW(Validate(config), std::invalid_argument);
+  try {
+    Validate(config);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("free_thresh"), std::string::npos) << error.what();
+  }
   config = {};
   config.hit_probability = 0.4;
   EXPECT_THROW(Validate(config), std::invalid_argument);

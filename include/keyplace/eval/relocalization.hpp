@@ -43,7 +43,7 @@ struct FixEvent {
   double confidence = 0.0;
   // As reported at `scan`: the robot's pose and the fix's variances (RelocalizationUpdate), what
   // a robot would publish on /initialpose.
-  Pose2 T_world_robot_reported;
+  Pose2 T_world_robot_at_fix;
   double position_variance_m2 = 0.0;
   double heading_variance_rad2 = 0.0;
   bool correct = false;

@@ -42,8 +42,9 @@ struct MergeResult {
 
 /// Recognises every submap of B in A with `place`, takes the largest group of recognitions that
 /// agree on B's frame, fits T_a_b to it (mean heading, then the least-squares translation of the
-/// group's B submap origins) and joins the maps: B's ids follow A's with a gap (no B submap is a
-/// map neighbour of an A submap) and its scan numbers follow A's. The merged map belongs to no
+/// group's B submap origins) and joins the maps: B's ids start at the second thousand after A's
+/// last (no B submap is a map neighbour of an A submap at any verification reach below 1000)
+/// and its scan numbers follow A's. The merged map belongs to no
 /// single log (empty source_hash). Throws std::invalid_argument when the maps were made with
 /// different mapping settings, or when fewer than options.min_agreeing recognitions agree (no
 /// reliable overlap: saying how many were found and how many agreed).

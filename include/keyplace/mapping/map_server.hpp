@@ -12,11 +12,16 @@
 namespace keyplace {
 
 // Pixel values of a trinary map_server image (negate 0): map_server reads a pixel v as occupancy
-// (255 - v) / 255, so 0 is occupied (1.0 >= occupied_thresh), 254 free (0.004 <= free_thresh) and
-// 205 unknown (0.196: neither, with map_saver's thresholds 0.65 and 0.196).
+// (255 - v) / 255 and calls it occupied above occupied_thresh, free below free_thresh. The YAML
+// always carries map_saver's thresholds 0.65 and 0.196, which decode these three values as
+// written: 0 (1.0) occupied, 254 (0.004) free, 205 (0.196: neither) unknown. The grid's own
+// thresholds (grid.occupied_thresh, grid.free_thresh) decide which value a cell gets; writing
+// them into the YAML instead could make map_server read unknown pixels as free.
 inline constexpr std::uint8_t kMapServerOccupied = 0;
 inline constexpr std::uint8_t kMapServerFree = 254;
 inline constexpr std::uint8_t kMapServerUnknown = 205;
+inline constexpr double kMapServerOccupiedThresh = 0.65;
+inline constexpr double kMapServerFreeThresh = 0.196;
 
 /// The image file of a map_server YAML path: the same path with the extension ".pgm".
 std::string MapServerImagePath(const std::string& yaml_path);
@@ -44,12 +49,13 @@ struct MapServerMap {
   std::vector<std::uint8_t> pixels;  // row-major, top row first (as in the image)
 
   /// The occupancy map_server gives pixel (column, image_row): (255 - v) / 255, or v / 255 when
-  /// negate is 1.
+  /// negate is 1; occupied above occupied_thresh, free below free_thresh.
   double Occupancy(int column, int image_row) const;
 };
 
 /// Reads a map_server YAML and its binary PGM (P5, 8-bit) image. Throws std::invalid_argument
-/// naming the file and the key or the image field that is missing or wrong.
+/// naming the file and the key or the image field that is missing or wrong, std::runtime_error
+/// naming the file that cannot be opened.
 MapServerMap ReadMapServerMap(const std::string& yaml_path);
 
 }  // namespace keyplace

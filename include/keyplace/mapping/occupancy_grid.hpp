@@ -22,9 +22,9 @@ struct OccupancyGridConfig {
   double miss_probability = 0.4;
   double min_probability = 0.12;
   double max_probability = 0.97;
-  // Written to the map_server YAML and used to classify cells in the image (trinary):
-  // probability >= occupied_thresh is occupied (0), <= free_thresh is free (254), else unknown
-  // (205). 0.65 and 0.196 are map_server's and map_saver's own values.
+  // Classify the cells for the trinary image: probability >= occupied_thresh is occupied (pixel
+  // 0), <= free_thresh free (254), else unknown (205). 0.65 and 0.196 are map_saver's values.
+  // The YAML always carries the thresholds that decode those pixels (map_server.hpp).
   double occupied_thresh = 0.65;
   double free_thresh = 0.196;
   // Beams are traced at most this far (a no-return beam is not traced): far beams at grazing

@@ -75,6 +75,7 @@ struct LogInputs {
   std::string source_hash;                       // CarmenLog::fingerprint of the log
   std::size_t first_scan = 0;                    // index in the file of scans[0]
   std::size_t file_scans = 0;                    // scans in the file (before the cut)
+  bool start_at_origin = false;                  // poses in the first kept scan's frame
   double seconds_read = 0.0;
   double seconds_poses = 0.0;
   double seconds_keypoints = 0.0;
