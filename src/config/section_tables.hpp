@@ -5,6 +5,7 @@
 #include "common/config_fields.hpp"
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/features/flirt.hpp"
+#include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -27,5 +28,6 @@ const ConfigFields<LoopRefinementConfig>& LoopRefinementConfigFields();
 const ConfigFields<SlamConfig>& SlamConfigFields();
 const ConfigFields<LocalizerConfig>& LocalizerConfigFields();
 const ConfigFields<EvaluationConfig>& EvaluationConfigFields();
+const ConfigFields<BagInputConfig>& BagInputConfigFields();
 
 }  // namespace keyplace

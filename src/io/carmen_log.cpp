@@ -22,6 +22,7 @@
 
 #include "io/file_fingerprint.hpp"
 #include "io/sqlite_magic.hpp"
+#include "keyplace/io/ros1_bag.hpp"
 
 namespace keyplace {
 namespace {
@@ -48,6 +49,14 @@ class LineReader {
       throw std::invalid_argument(
           path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
           (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
+    }
+    static constexpr std::string_view kBagMagic = "#ROSBAG V2.0\n";
+    EnsureRaw(kBagMagic.size());
+    if (raw_end_ >= kBagMagic.size() &&
+        std::memcmp(raw_.data(), kBagMagic.data(), kBagMagic.size()) == 0) {
+      // A regular file never gets here (ReadCarmenLog hands it to ReadRos1Bag).
+      throw std::invalid_argument(path + ": a ROS 1 bag through a pipe or device: rosbag seeks, " +
+                                  "so give the bag as a regular file");
     }
     gzip_ = StartsWithGzipMagic();
     if (gzip_) StartInflating();
@@ -677,6 +686,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   if (!(options.max_coordinate_m > 0.0)) {
     throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
   }
+  if (IsRos1Bag(path)) return ReadRos1Bag(path, options.bag, options.max_coordinate_m);
   ReaderState state;
   state.options = options;
   state.log.path = path;
@@ -750,6 +760,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
 CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options) {
   CarmenLog log = ReadCarmenLog(path, options);
   if (log.scans.empty()) {
+    // A bag without scans is an error in ReadRos1Bag, naming the topic.
     throw std::invalid_argument(path +
                                 ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
                                 std::to_string(log.lines) + " lines: is this a CARMEN log?");
