@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <stdexcept>
@@ -217,6 +218,8 @@ CarmenLog ReadRos1Bag(const std::string& path, const BagInputConfig& config,
   }
   CarmenLog log = AssembleBagLog(path, config, summary, std::move(decoder.contents()));
   log.fingerprint = FileFingerprint(path);
+  std::error_code ignored;
+  log.file_bytes = std::filesystem::file_size(path, ignored);
   return log;
 }
 

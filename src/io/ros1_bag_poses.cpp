@@ -68,7 +68,6 @@ class PoseAssembler {
       Interpolate(log,
                   [&](double stamp_s, TrackPosition* where) { return track.At(stamp_s, where); });
       log.odometry = std::move(contents_.odometry);
-      source_ = "topic " + topic;
       return;
     }
     const std::vector<double> stamps =
@@ -82,6 +81,8 @@ class PoseAssembler {
     const auto lookup = [&](double stamp_s, TrackPosition* where) {
       return *contents_.tf.Lookup(config_.odom_frame, config_.base_frame, stamp_s, where);
     };
+    log.warnings.push_back(path_ + ": no topic " + topic + ": odometry from /tf " +
+                           config_.odom_frame + " -> " + config_.base_frame);
     Interpolate(log, lookup);
     for (const double stamp_s : stamps) {
       OdometryMessage message;
@@ -89,8 +90,6 @@ class PoseAssembler {
       message.timestamp_s = message.logger_timestamp_s = stamp_s;
       log.odometry.push_back(message);
     }
-    source_ = "/tf " + config_.odom_frame + " -> " + config_.base_frame;
-    log.warnings.push_back(path_ + ": no topic " + topic + ": odometry from " + source_);
   }
 
   // Sets T_robot_laser and logged_laser_pose of every scan.
@@ -140,12 +139,20 @@ class PoseAssembler {
       if (where.gap_s > kLongOdometryGapS) ++in_gaps;
       longest_gap_s = std::max(longest_gap_s, where.gap_s);
     }
-    if (held > 0 || in_gaps > 0) {
-      log.warnings.push_back(path_ + ": " + std::to_string(held) +
-                             " scans lie before the first or after the last odometry sample (the " +
-                             "end pose is held) and " + std::to_string(in_gaps) +
-                             " in odometry gaps over " + Seconds(kLongOdometryGapS) +
-                             " s; the longest gap is " + Seconds(longest_gap_s) + " s");
+    std::string what;
+    if (held > 0) {
+      what = std::to_string(held) + " of " + std::to_string(log.scans.size()) +
+             " scans lie before the first or after the last odometry sample (the end pose is "
+             "held)";
+    }
+    if (in_gaps > 0) {
+      what += (what.empty() ? "" : "; ") + std::to_string(in_gaps) + " of " +
+              std::to_string(log.scans.size()) + " scans lie in odometry gaps over " +
+              Seconds(kLongOdometryGapS) + " s";
+    }
+    if (!what.empty()) {
+      log.warnings.push_back(path_ + ": " + what + "; the longest gap is " +
+                             Seconds(longest_gap_s) + " s");
     }
   }
 
@@ -153,7 +160,6 @@ class PoseAssembler {
   const BagInputConfig& config_;
   const BagSummary& summary_;
   BagContents& contents_;
-  std::string source_;
 };
 
 }  // namespace
@@ -171,7 +177,6 @@ CarmenLog AssembleBagLog(const std::string& path, const BagInputConfig& config,
   assembler.AddOdometry(log);
   assembler.AddLaserPose(log);
   log.lines = summary.messages;
-  for (const LogTopic& topic : summary.topics) log.line_counts[topic.name] = topic.messages;
   log.invalid_beams = contents.invalid_beams;
   log.no_return_beams = contents.no_return_beams;
   return log;
