@@ -28,7 +28,7 @@ struct InfoOptions {
   std::string json_path;
   bool skip_bad_lines = false;
   bool check = false;
-  ConfigOptions config;  // only the ROS bag flags
+  ConfigOptions config;  // for a bag, its input section
 };
 
 double PathLength(const CarmenLog& log) {
@@ -289,7 +289,7 @@ void RegisterInfoCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   command->add_option("--json", options->json_path, "Also write the figures as JSON to FILE");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
-  AddBagOptions(command, options->config);
+  AddConfigOptions(command, options->config);  // the input section: how a bag is read
   command->add_flag("--check", options->check,
                     "Verify a map file: SQLite header and integrity check, schema, format "
                     "version, content checksum, configuration, every row; print each check and "
