@@ -151,7 +151,6 @@ class ChunkWalker {
     }
     WalkChunk(chunk, offset);
     ++chunks_;
-    last_chunk_end_ = static_cast<std::uint64_t>(file_.tellg());
   }
 
   [[noreturn]] void FailChunk(std::uint64_t offset, const std::string& why) const {
@@ -249,7 +248,6 @@ class ChunkWalker {
   std::size_t messages_ = 0;
   std::size_t chunks_ = 0;
   std::uint32_t expected_chunks_ = 0;
-  std::uint64_t last_chunk_end_ = 0;
   std::optional<std::uint64_t> cut_offset_;
   bool damaged_ = false;
 };
