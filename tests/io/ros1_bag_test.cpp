@@ -40,7 +40,7 @@ std::string ReadBytes(const std::string& path) {
 }
 
 std::string WriteBytes(const std::string& name, const std::string& bytes) {
-  const std::string path = testing::MakeTempDir("ros1bag") + "/" + name;
+  std::string path = testing::MakeTempDir("ros1bag") + "/" + name;
   std::ofstream(path, std::ios::binary) << bytes;
   return path;
 }

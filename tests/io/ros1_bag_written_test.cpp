@@ -75,7 +75,7 @@ struct Content {
 };
 
 std::string WriteBag(const std::string& name, const Content& content) {
-  const std::string path = testing::MakeTempDir("written") + "/" + name;
+  std::string path = testing::MakeTempDir("written") + "/" + name;
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   bag.setCompression(content.compression);
   const ros::Time t10(10.0);
