@@ -11,6 +11,9 @@ packages=(
   libeigen3-dev libnanoflann-dev libceres-dev zlib1g-dev libsqlite3-dev sqlite3
   libcli11-dev libfmt-dev libspdlog-dev libtbb-dev libcairo2-dev libyaml-cpp-dev
   nlohmann-json3-dev pybind11-dev python3-dev
+  # ROS 1 bags: Debian's rosbag storage library, the message headers, the chunk codecs
+  librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libgeometry-msgs-dev
+  libroslz4-dev libbz2-dev
   # the CLI tests read JSON with python3
   python3
   # tests, benchmarks, style

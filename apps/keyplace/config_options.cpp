@@ -16,6 +16,26 @@ void AddConfigOptions(CLI::App* command, ConfigOptions& options) {
   command->add_option("--set", options.assignments,
                       "Override one setting, section.key=value (repeatable; keys: keyplace "
                       "dump-config)");
+  AddBagOptions(command, options);
+}
+
+void AddBagOptions(CLI::App* command, ConfigOptions& options) {
+  command->add_option("--scan-topic", options.scan_topic,
+                      "ROS bag input: sensor_msgs/LaserScan topic (input.scan_topic, default "
+                      "/scan)");
+  command->add_option("--odom-topic", options.odom_topic,
+                      "ROS bag input: nav_msgs/Odometry topic (input.odom_topic, default /odom; "
+                      "without it in the bag: /tf odom -> base_link)");
+  command->add_option("--laser-pose", options.laser_pose,
+                      "ROS bag input: laser on the robot as x,y,theta (m, m, rad), overriding "
+                      "/tf_static and /tf (input.laser_pose)");
+}
+
+CarmenReadOptions ReadingOptions(const Config& config, bool skip_bad_lines) {
+  CarmenReadOptions reading;
+  reading.skip_bad_lines = skip_bad_lines;
+  reading.bag = config.input;
+  return reading;
 }
 
 Config ResolveConfig(const ConfigOptions& options, const std::function<void(Config&)>& after_preset,
@@ -24,6 +44,9 @@ Config ResolveConfig(const ConfigOptions& options, const std::function<void(Conf
   if (after_preset) after_preset(config);
   if (!options.file.empty()) ApplyConfigFile(options.file, config);
   for (const std::string& alias : aliases) ApplyConfigAssignment(alias, config);
+  if (!options.scan_topic.empty()) SetConfigValue("input.scan_topic", options.scan_topic, config);
+  if (!options.odom_topic.empty()) SetConfigValue("input.odom_topic", options.odom_topic, config);
+  if (!options.laser_pose.empty()) SetConfigValue("input.laser_pose", options.laser_pose, config);
   for (const std::string& assignment : options.assignments) {
     ApplyConfigAssignment(assignment, config);
   }

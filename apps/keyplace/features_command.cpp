@@ -31,7 +31,7 @@ struct FeaturesOptions {
 
 void RunFeatures(const FeaturesOptions& options) {
   const Config config = ResolveConfig(options.config);
-  const CarmenLog log = ReadLogWithScans(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input, ReadingOptions(config));
   const ScanRange range = ParseScanRange(options.scans, log.scans.size());
   const FlirtExtractor extractor(config.features);
 
@@ -122,7 +122,7 @@ void RegisterFeaturesCommand(CLI::App& app) {
       "features",
       "Extract FLIRT keypoints (curvature detector + beta-grid descriptor, FLIRTLib defaults; "
       "--set features.KEY=VALUE changes them) from the scans of a log and print statistics.");
-  command->add_option("input", options->input, "CARMEN log (.log or .log.gz)")
+  command->add_option("input", options->input, "CARMEN log (.log, .log.gz) or ROS 1 bag")
       ->required()
       ->check(CLI::ExistingFile);
   command

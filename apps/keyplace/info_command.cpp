@@ -28,6 +28,7 @@ struct InfoOptions {
   std::string json_path;
   bool skip_bad_lines = false;
   bool check = false;
+  ConfigOptions config;  // for a bag, its input section
 };
 
 double PathLength(const CarmenLog& log) {
@@ -45,6 +46,7 @@ double PathLength(const CarmenLog& log) {
 nlohmann::json DescribeLog(const CarmenLog& log) {
   nlohmann::json json;
   json["file"] = log.path;
+  json["format"] = log.format;
   json["file_bytes"] = log.file_bytes;
   json["fingerprint"] = log.fingerprint;
   json["lines"] = log.lines;
@@ -72,6 +74,11 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
   json["graph_loop_edges"] =
       std::count_if(log.edges.begin(), log.edges.end(), [](const GraphEdge& e) { return e.loop; });
   json["line_counts"] = log.line_counts;
+  json["topics"] = nlohmann::json::array();
+  for (const LogTopic& topic : log.topics) {
+    json["topics"].push_back(
+        {{"topic", topic.name}, {"type", topic.type}, {"messages", topic.messages}});
+  }
   json["skipped_lines"] = log.skipped_lines;
   json["truncated_last_line"] = log.truncated_last_line;
   json["warnings"] = log.warnings;
@@ -79,7 +86,8 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
 }
 
 void PrintLog(const nlohmann::json& json) {
-  fmt::print("file            {}\n", json["file"].get<std::string>());
+  fmt::print("file            {} ({})\n", json["file"].get<std::string>(),
+             json["format"].get<std::string>());
   fmt::print("scans           {} ({} poses)\n", json["scans"].get<std::size_t>(),
              json["pose_kind"].get<std::string>());
   const auto min_beams = json["beams_per_scan_min"].get<std::size_t>();
@@ -101,6 +109,14 @@ void PrintLog(const nlohmann::json& json) {
   fmt::print("no-return beams {}\n", json["no_return_beams"].get<std::size_t>());
   fmt::print("invalid beams   {} (NaN, infinite, zero or negative ranges)\n",
              json["invalid_beams"].get<std::size_t>());
+  if (!json["topics"].empty()) {
+    fmt::print("messages        {}\n", json["lines"].get<std::size_t>());
+    for (const auto& topic : json["topics"]) {
+      fmt::print("  {:<14}{:<26}{}\n", topic["topic"].get<std::string>(),
+                 topic["type"].get<std::string>(), topic["messages"].get<std::size_t>());
+    }
+    return;
+  }
   fmt::print("lines           {}\n", json["lines"].get<std::size_t>());
   for (const auto& [type, count] : json["line_counts"].items()) {
     fmt::print("  {:<14}{}\n", type, count.get<std::size_t>());
@@ -229,8 +245,8 @@ void RunInfo(const InfoOptions& options) {
     json = DescribeMap(options.input, LoadMap(options.input));
     PrintMap(json);
   } else {
-    CarmenReadOptions reading;
-    reading.skip_bad_lines = options.skip_bad_lines;
+    CarmenReadOptions reading =
+        ReadingOptions(ResolveConfig(options.config), options.skip_bad_lines);
     reading.keep_beams = false;  // a summary: logs larger than memory can be described
     const CarmenLog log = ReadLogWithScans(options.input, reading);
     PrintLogWarnings(log);
@@ -247,13 +263,17 @@ void RegisterInfoCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "info",
       "Describe a CARMEN log (scans, beams, field of view, duration, path length, line types, "
-      "invalid beams) or a map file (submaps, keypoints, the configuration that made it); "
+      "invalid beams), a ROS 1 bag (the same, and its topics, types and message counts) or a map "
+      "file (submaps, keypoints, the configuration that made it); "
       "--check verifies a map file.");
-  command->add_option("input", options->input, "CARMEN log (.log or .log.gz) or map file (.kpm)")
+  command
+      ->add_option("input", options->input,
+                   "CARMEN log (.log, .log.gz), ROS 1 bag or map file (.kpm)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--json", options->json_path, "Also write the figures as JSON to FILE");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
+  AddConfigOptions(command, options->config);  // the input section: how a bag is read
   command->add_flag("--check", options->check,
                     "Verify a map file: SQLite header and integrity check, schema, format "
                     "version, content checksum, configuration, every row; print each check and "

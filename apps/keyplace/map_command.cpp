@@ -152,7 +152,7 @@ void RunMap(const MapOptions& options) {
     }
   });
   LogInputOptions input_options;
-  input_options.reading.skip_bad_lines = options.skip_bad_lines;
+  input_options.reading = ReadingOptions(config, options.skip_bad_lines);
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.start_at_origin = options.start_at_origin;
@@ -188,7 +188,7 @@ void RegisterMapCommand(CLI::App& app) {
       "map",
       "Build a global map of submaps of stable FLIRT keypoints from a log (paper Algorithms 1-2) "
       "and print the mapping criteria of the paper's Section 5.1.");
-  command->add_option("input", options->input, "CARMEN log (.log or .log.gz)")
+  command->add_option("input", options->input, "CARMEN log (.log, .log.gz) or ROS 1 bag")
       ->required()
       ->check(CLI::ExistingFile);
   command

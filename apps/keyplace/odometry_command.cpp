@@ -52,7 +52,7 @@ void RunOdometry(const OdometryOptions& options) {
     throw std::invalid_argument("--corrected and --raw-to-corrected must be given together");
   }
 
-  const CarmenLog log = ReadLogWithScans(options.input);
+  const CarmenLog log = ReadLogWithScans(options.input, ReadingOptions(config));
   OdometryRunOptions run_options;
   run_options.order = ParseScanOrder(options.order);
   ScanRange range{0, log.scans.size()};
@@ -114,7 +114,9 @@ void RegisterOdometryCommand(CLI::App& app) {
       "(|t_b - t_a| < evaluation.local_relation_max_dt_s) and loop relations. The trajectory is "
       "the robot pose, in the odometry frame of the first scan. ICP settings: --set "
       "odometry.KEY=VALUE and odometry.icp.KEY=VALUE (keyplace dump-config lists them).");
-  command->add_option("input", options->input, "raw CARMEN log with odometry (.log or .log.gz)")
+  command
+      ->add_option("input", options->input,
+                   "raw CARMEN log with odometry (.log, .log.gz) or ROS 1 bag")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--out", options->out_path,

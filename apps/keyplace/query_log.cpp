@@ -1,12 +1,15 @@
 #include "query_log.hpp"
 
 #include "cli_support.hpp"
+#include "config_options.hpp"
 
 namespace keyplace::cli {
 
 void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
                         const std::string& poses_help) {
-  command->add_option("--log", options.log_path, "Query log (corrected or raw)")
+  command
+      ->add_option("--log", options.log_path,
+                   "Query log (corrected or raw CARMEN log, or ROS 1 bag)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--poses", options.poses, poses_help)
@@ -33,7 +36,7 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
 
 QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {
   QueryLog query;
-  query.input_options.reading.skip_bad_lines = options.skip_bad_lines;
+  query.input_options.reading = ReadingOptions(config, options.skip_bad_lines);
   query.input_options.poses = ParsePoseSource(options.poses);
   query.input_options.odometry = config.odometry;
   query.input_options.features = config.features;

@@ -45,6 +45,7 @@ struct SlamOptions {
 LogInputs PrepareInputs(const std::string& path, const Config& config) {
   LogInputOptions options;
   options.compute_poses = false;
+  options.reading = ReadingOptions(config);
   options.features = config.features;
   return PrepareLogInputs(path, options, StageProgressBar());
 }
@@ -128,7 +129,7 @@ void RegisterSlamCommand(CLI::App& app) {
       "ATE/RPE and relation errors. Tuning: --set slam.KEY=VALUE (e.g. "
       "slam.exclude_recent_submaps, slam.gate_base_m=0 for no gate, slam.loop_refinement.refine), "
       "--set mapping.KEY=VALUE, --set place.KEY=VALUE, --preset paper.");
-  command->add_option("input", options->input, "raw CARMEN log (.log or .log.gz)")
+  command->add_option("input", options->input, "raw CARMEN log (.log, .log.gz) or ROS 1 bag")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--out", options->out_path, "write the SLAM map (.kpm)");

@@ -43,6 +43,7 @@ struct SweepOptions {
 // The expensive inputs shared by every grid point: the log (cut to --scans), poses, keypoints.
 LogInputs PrepareInputs(const SweepOptions& options, const Config& config, bool need_corrected) {
   LogInputOptions input_options;
+  input_options.reading = ReadingOptions(config);
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
   input_options.odometry = config.odometry;
   input_options.features = config.features;
@@ -210,7 +211,7 @@ void RegisterSweepCommand(CLI::App& app) {
       "mapping",
       "Mapping criteria of Section 5.1 (compression, #scans, #keypoints, distribution, "
       "#submaps, time) over a grid of s_min and l_g (Figure 8).");
-  mapping_command->add_option("--log", mapping->log_path, "CARMEN log (.log or .log.gz)")
+  mapping_command->add_option("--log", mapping->log_path, "CARMEN log (.log, .log.gz) or ROS 1 bag")
       ->required()
       ->check(CLI::ExistingFile);
   mapping_command

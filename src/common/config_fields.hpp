@@ -60,6 +60,13 @@ class ConfigFields {
         });
   }
 
+  ConfigFields& Text(const char* name, std::string Config::*member, const char* unit,
+                     const char* doc) {
+    return Add(
+        {name, unit, doc}, [member](const Config& c) { return c.*member; },
+        [member](const std::string& text, Config& c) { c.*member = text; });
+  }
+
   ConfigFields& Bool(const char* name, bool Config::*member, const char* doc) {
     return Add(
         {name, "", doc},

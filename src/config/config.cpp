@@ -12,7 +12,8 @@ namespace {
 const ConfigFields<Config>& ConfigTable() {
   static const ConfigFields<Config> fields = [] {
     ConfigFields<Config> table("config");
-    table.Nested("features", &Config::features, FlirtConfigFields())
+    table.Nested("input", &Config::input, BagInputConfigFields())
+        .Nested("features", &Config::features, FlirtConfigFields())
         .Nested("odometry", &Config::odometry, ScanOdometryConfigFields())
         .Nested("mapping", &Config::mapping, MappingConfigFields())
         .Nested("place", &Config::place, PlaceConfigFields())
@@ -29,6 +30,7 @@ const ConfigFields<Config>& ConfigTable() {
 // Validates the section `key` belongs to.
 void ValidateSection(const std::string& key, const Config& config) {
   const std::string section = key.substr(0, key.find('.'));
+  if (section == "input") Validate(config.input);
   if (section == "features") ValidateFlirtConfig(config.features);
   if (section == "odometry") ValidateScanOdometryConfig(config.odometry);
   if (section == "mapping") Validate(config.mapping);
@@ -150,6 +152,7 @@ Config PresetConfig(const std::string& name) {
 }
 
 void Validate(const Config& config) {
+  Validate(config.input);
   ValidateFlirtConfig(config.features);
   ValidateScanOdometryConfig(config.odometry);
   Validate(config.mapping);

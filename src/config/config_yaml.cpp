@@ -25,6 +25,24 @@ std::vector<std::string> SplitKey(const std::string& key) {
   return parts;
 }
 
+// A value as a YAML scalar: plain when it reads back as the same text (numbers, names, topics),
+// double-quoted otherwise (an empty text field would read back as nothing).
+std::string YamlScalar(const std::string& value) {
+  const bool plain = !value.empty() && value.front() != '-' &&
+                     value.find_first_not_of(
+                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                         "0123456789_./,+") == std::string::npos;
+  const bool number =
+      !value.empty() && value.find_first_not_of("0123456789.-+eE,") == std::string::npos;
+  if (plain || (number && value.find(',') == std::string::npos)) return value;
+  std::string quoted = "\"";
+  for (const char c : value) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
 std::string Comment(const ConfigFieldInfo& field) {
   std::string text = field.unit.empty() ? "" : "[" + field.unit + "] ";
   return text + field.doc;
@@ -78,7 +96,7 @@ std::string ConfigToYaml(const Config& config) {
       out << std::string(2 * depth, ' ') << parts[depth] << ":\n";
       open.push_back(parts[depth]);
     }
-    out << std::string(2 * parts.size(), ' ') << name << ": " << field.value << "  # "
+    out << std::string(2 * parts.size(), ' ') << name << ": " << YamlScalar(field.value) << "  # "
         << Comment(field) << '\n';
   }
   return out.str();

@@ -5,6 +5,7 @@
 #include "common/config_fields.hpp"
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/features/flirt.hpp"
+#include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/localization/map_merge.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
@@ -31,5 +32,6 @@ const ConfigFields<LocalizerConfig>& LocalizerConfigFields();
 const ConfigFields<EvaluationConfig>& EvaluationConfigFields();
 const ConfigFields<OccupancyGridConfig>& OccupancyGridConfigFields();
 const ConfigFields<MergeOptions>& MergeOptionsFields();
+const ConfigFields<BagInputConfig>& BagInputConfigFields();
 
 }  // namespace keyplace

@@ -24,6 +24,7 @@
 
 #include "io/file_fingerprint.hpp"
 #include "io/sqlite_magic.hpp"
+#include "keyplace/io/ros1_bag.hpp"
 
 namespace keyplace {
 namespace {
@@ -53,6 +54,14 @@ class LineReader {
       throw std::invalid_argument(
           path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
           (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
+    }
+    static constexpr std::string_view kBagMagic = "#ROSBAG V2.0\n";
+    EnsureRaw(kBagMagic.size());
+    if (raw_end_ >= kBagMagic.size() &&
+        std::memcmp(raw_.data(), kBagMagic.data(), kBagMagic.size()) == 0) {
+      // A regular file never gets here (ReadCarmenLog hands it to ReadRos1Bag).
+      throw std::invalid_argument(path + ": a ROS 1 bag through a pipe or device: rosbag seeks, " +
+                                  "so give the bag as a regular file");
     }
     gzip_ = StartsWithGzipMagic();
     if (gzip_) StartInflating();
@@ -611,11 +620,10 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
   return scan;
 }
 
-// Counts the scan's beams and keeps it, without its beams unless the options keep them.
-void AddScan(LogScan scan, ReaderState& state) {
-  CarmenLog& log = state.log;
+// Adds the scan's beams to the log's counts (the first scan also gives the field of view).
+void CountBeams(const LogScan& scan, bool first, CarmenLog& log) {
   const std::size_t beams = scan.size();
-  if (log.scans.empty()) {
+  if (first) {
     log.beams_per_scan_min = log.beams_per_scan_max = beams;
     if (beams > 1) {
       const double span_rad = scan.angles_rad.back() - scan.angles_rad.front();
@@ -625,12 +633,19 @@ void AddScan(LogScan scan, ReaderState& state) {
   log.beams_per_scan_min = std::min(log.beams_per_scan_min, beams);
   log.beams_per_scan_max = std::max(log.beams_per_scan_max, beams);
   log.beams_total += beams;
-  if (!state.options.keep_beams) {
-    std::vector<double>().swap(scan.ranges_m);
-    std::vector<double>().swap(scan.angles_rad);
-    std::vector<std::uint8_t>().swap(scan.valid);
-  }
-  log.scans.push_back(std::move(scan));
+}
+
+void ReleaseBeams(LogScan& scan) {
+  std::vector<double>().swap(scan.ranges_m);
+  std::vector<double>().swap(scan.angles_rad);
+  std::vector<std::uint8_t>().swap(scan.valid);
+}
+
+// Counts the scan's beams and keeps it, without its beams unless the options keep them.
+void AddScan(LogScan scan, ReaderState& state) {
+  CountBeams(scan, state.log.scans.empty(), state.log);
+  if (!state.options.keep_beams) ReleaseBeams(scan);
+  state.log.scans.push_back(std::move(scan));
 }
 
 void ParseLine(const std::string& path, std::size_t line_number,
@@ -734,6 +749,17 @@ void ReadLines(const std::string& path, LineReader& reader, ReaderState& state,
   }
 }
 
+// A bag read as a log, with the beam counts the line reader keeps as it goes, and without beams
+// when the options say so.
+CarmenLog BagLog(const std::string& path, const CarmenReadOptions& options) {
+  CarmenLog log = ReadRos1Bag(path, options.bag, options.max_coordinate_m);
+  for (std::size_t k = 0; k < log.scans.size(); ++k) {
+    CountBeams(log.scans[k], k == 0, log);
+    if (!options.keep_beams) ReleaseBeams(log.scans[k]);
+  }
+  return log;
+}
+
 // What a reader out of memory says instead of a bare std::bad_alloc: where it was and how much
 // it held, so the user knows the log itself is too large for this machine. The scans are
 // released first: the message itself needs memory.
@@ -757,6 +783,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   if (!(options.max_coordinate_m > 0.0)) {
     throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
   }
+  if (IsRos1Bag(path)) return BagLog(path, options);
   ReaderState state;
   state.options = options;
   state.log.path = path;
@@ -804,6 +831,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
 CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options) {
   CarmenLog log = ReadCarmenLog(path, options);
   if (log.scans.empty()) {
+    // A bag without scans is an error in ReadRos1Bag, naming the topic.
     throw std::invalid_argument(path +
                                 ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
                                 std::to_string(log.lines) + " lines: is this a CARMEN log?");

@@ -10,6 +10,7 @@
 
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/features/flirt.hpp"
+#include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/localization/map_merge.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
@@ -21,6 +22,7 @@
 namespace keyplace {
 
 struct Config {
+  BagInputConfig input;          // how a ROS bag becomes a log (README, "With ROS")
   FlirtConfig features;          // FLIRT keypoints (docs/FLIRT.md)
   ScanOdometryConfig odometry;   // ICP scan odometry (docs/REGISTRATION.md)
   MappingConfig mapping;         // stable-keypoint submaps (docs/MAPPING.md)

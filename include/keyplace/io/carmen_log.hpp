@@ -1,5 +1,6 @@
 #pragma once
-// Reader for CARMEN text logs (plain or gzip-compressed).
+// Reader for CARMEN text logs (plain or gzip-compressed), and the log structure every command
+// reads: ReadCarmenLog also reads a ROS 1 bag into it (ros1_bag.hpp), told apart by content.
 
 #include <cstddef>
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/io/laser_scan.hpp"
 
 namespace keyplace {
@@ -47,11 +49,23 @@ struct LogScan : LaserScan {
   // Recomposing robot pose * T_robot_laser differs from it by a few ulps, which is enough to
   // flip near-equal edge lengths in FLIRT's spanning trees.
   Pose2 logged_laser_pose;
-  std::size_t line = 0;  // 1-based line number of the laser line in its file
+  // 1-based line number of the laser line in its file; for a bag, the 1-based number of the
+  // message on the scan topic.
+  std::size_t line = 0;
+};
+
+/// A topic of a bag: name, message type and how many messages it holds.
+struct LogTopic {
+  std::string name;
+  std::string type;
+  std::size_t messages = 0;
 };
 
 struct CarmenLog {
   std::string path;
+  // "CARMEN log" or "ROS 1 bag"; for a bag the topics it holds (every one, not only those read).
+  std::string format = "CARMEN log";
+  std::vector<LogTopic> topics;
   std::vector<LogScan> scans;  // FLASER / RLASER / ROBOTLASER1 in file order
   std::vector<OdometryMessage> odometry;
   std::vector<GraphVertex> vertices;
@@ -105,12 +119,15 @@ struct CarmenReadOptions {
   // summary of a log (keyplace info) holds about 200 bytes per scan instead of 17 per beam. The
   // scans then have size() 0; only their stamps and poses are kept.
   bool keep_beams = true;
+  // How a ROS 1 bag becomes a log (topics, frames, laser pose); unused for CARMEN logs.
+  BagInputConfig bag;
 };
 
-/// Reads a CARMEN log. Throws std::invalid_argument naming file, line and field on malformed
-/// input (unless options.skip_bad_lines), std::runtime_error when the file cannot be opened or
-/// its compressed data are truncated. A last line without end of line that does not parse is
-/// dropped with a warning (CarmenLog::warnings): what a logger killed mid-line leaves.
+/// Reads a CARMEN log, or a ROS 1 bag (a regular file starting with "#ROSBAG V2.0", whatever
+/// its name) with ReadRos1Bag(path, options.bag). Throws std::invalid_argument naming file, line
+/// and field on malformed input (unless options.skip_bad_lines), std::runtime_error when the file
+/// cannot be opened or its compressed data are truncated. A last line without end of line that does
+/// not parse is dropped with a warning (CarmenLog::warnings): what a logger killed mid-line leaves.
 /// The file is opened once and read once, front to back, so it may be a pipe, a FIFO or
 /// /dev/fd/N; an SQLite file (a map) is an error saying so.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});

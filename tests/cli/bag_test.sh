@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# ROS 1 bags through the command line (issue 16): info lists topics, types and counts; map,
+# features and odometry read a bag like a log (the fr079 bag's scans are the rebuilt log's); the
+# bag flags and --set input.* reach the reader; a missing topic, a bad laser pose, a bag through a
+# pipe and a truncated bag get messages naming the bag and the problem.
+# Usage: bag_test.sh KEYPLACE_BINARY SOURCE_DIR
+set -uo pipefail
+keyplace=$1
+source_dir=$2
+shared=${KEYPLACE_SHARED:-$source_dir/../shared}
+bag="$shared/data/fr079.orig.bag"
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
+
+# info: topics with types and counts, as text and JSON.
+check "info bag" "$keyplace" info "$bag" --json "$work/info.json"
+grep -qE '^  /scan +sensor_msgs/LaserScan +4934$' "$work/out" && ok || fail "info lists /scan"
+grep -qE '^  /tf_static +tf2_msgs/TFMessage +1$' "$work/out" && ok || fail "info lists /tf_static"
+/usr/bin/python3 - "$work/info.json" <<'PY' && ok || fail "info JSON topics"
+import json, sys
+j = json.load(open(sys.argv[1]))
+topics = {t['topic']: (t['type'], t['messages']) for t in j['topics']}
+assert j['format'] == 'ROS 1 bag' and j['scans'] == 4934, j
+assert topics == {'/odom': ('nav_msgs/Odometry', 8951), '/scan': ('sensor_msgs/LaserScan', 4934),
+                  '/tf': ('tf2_msgs/TFMessage', 8951), '/tf_static': ('tf2_msgs/TFMessage', 1)}, topics
+PY
+
+# The bag with the log's beam spacing describes as the log rebuilt from it (the keypoints and
+# the map are compared exactly in tests/mapping/bag_map_test.cpp: they need the log's 6-decimal
+# poses).
+check "info log" "$keyplace" info "$shared/data/fr079-raw.log.gz" --json "$work/log.json"
+check "info bag as log" "$keyplace" info "$bag" --json "$work/bag.json" \
+  --laser-pose -0.04,0,0 --set input.scan_fov_rad=3.141592653589793
+/usr/bin/python3 - "$work/log.json" "$work/bag.json" "$work/info.json" <<'PY' && ok || fail "bag and log describe alike"
+import json, sys
+log, bag, raw = (json.load(open(p)) for p in sys.argv[1:])
+for key in ('scans', 'beams_total', 'no_return_beams', 'invalid_beams', 'field_of_view_deg',
+            'odometry_messages'):
+    assert log[key] == bag[key], (key, log[key], bag[key])
+assert abs(log['path_length_m'] - bag['path_length_m']) < 1e-3, (log['path_length_m'], bag['path_length_m'])
+assert abs(raw['field_of_view_deg'] - 180.5) < 0.01, raw['field_of_view_deg']  # pi/359 steps
+PY
+check "features bag" "$keyplace" features "$bag" --scans 0:200 --tsv "$work/bag.tsv"
+[ "$(wc -l <"$work/bag.tsv")" -gt 1000 ] && ok || fail "features of a bag"
+
+# map and odometry run on a bag; the laser pose given is recorded in the map's configuration.
+check "map bag" "$keyplace" map "$bag" --scans 0:400 --laser-pose=-0.04,0,0 --json "$work/map.json"
+/usr/bin/python3 -c "
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['config']['input']['laser_pose'] == '-0.04,0,0' and j['submaps'] > 0, j['config']['input']
+" "$work/map.json" && ok || fail "map JSON records input.laser_pose"
+check "odometry bag" "$keyplace" odometry "$bag" --scans 0:300
+check "dump-config bag flags" "$keyplace" dump-config --scan-topic /base_scan
+grep -qF 'scan_topic: /base_scan' "$work/out" && ok || fail "--scan-topic sets input.scan_topic"
+
+# Errors name the bag and the problem.
+fails_with "missing topic" "$bag: no topic /base_scan" "$keyplace" map "$bag" --scan-topic /base_scan
+grep -qF '/scan (sensor_msgs/LaserScan, 4934)' "$work/err" && ok || fail "missing topic lists topics"
+fails_with "wrong type" "topic /tf holds tf2_msgs/TFMessage messages, not sensor_msgs/LaserScan" \
+  "$keyplace" info "$bag" --scan-topic /tf
+fails_with "bad laser pose" "input.laser_pose" "$keyplace" info "$bag" --laser-pose 1,2
+fails_with "bag through a pipe" "a ROS 1 bag through a pipe" \
+  "$keyplace" info <(cat "$bag")
+
+# A bag cut off: its complete chunks are read, with a warning naming it.
+head -c 1300000 "$bag" >"$work/cut.bag"
+check "truncated bag" "$keyplace" info "$work/cut.bag"
+grep -qF "$work/cut.bag: the bag's index is missing or damaged" "$work/err" && ok ||
+  fail "truncated bag warning"
+
+finish bag_test
