@@ -8,6 +8,10 @@ DEMO_OUT := $(BUILD_DIR)/demo
 REPORT_DIR ?= $(BUILD_DIR)/report
 KEYPLACE_SHARED ?= ../shared
 SANITIZE_DIR ?= build-sanitize
+# make fuzz (docs/RELIABILITY.md, Fuzzing): the libFuzzer build and how long each harness runs.
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_SEED ?= 1
 # The sanitizer run (docs/RELIABILITY.md, Sanitizers): the first report ends the test program
 # with its stack. allocator_may_return_null: an impossible allocation throws std::bad_alloc as in
 # the ordinary build (tests check the messages) instead of ending the process. Leaks of system
@@ -21,7 +25,7 @@ SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return
 # DescriptorIndex.*, PlaceDatabase.*, Ros1Bag*).
 SANITIZE_SKIP := ^(GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog|DescriptorIndex.SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog|BagMap.Fr079BagGivesTheMapOfTheLogRebuiltFromIt)$$
 
-.PHONY: all deps configure build demo test test-sanitize bench report format format-check tidy \
+.PHONY: all deps configure build demo test test-sanitize fuzz bench report format format-check tidy \
   install clean
 
 all: build
@@ -52,6 +56,18 @@ test-sanitize: deps
 	  $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
 	@cd $(SANITIZE_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_SKIP)'
+
+# The libFuzzer harnesses of tests/fuzz, built with clang, ASan and UBSan in $(FUZZ_DIR) (the
+# library and the harnesses only), each run for FUZZ_SECONDS with seed FUZZ_SEED on a scratch
+# copy of its seed corpus; inputs of findings are kept in $(FUZZ_DIR)/findings/.
+fuzz: deps
+	@cmake -S . -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DKEYPLACE_FUZZ=ON \
+	  -DKEYPLACE_BUILD_TESTS=OFF -DKEYPLACE_BUILD_APPS=OFF -DKEYPLACE_BUILD_BENCHMARKS=OFF \
+	  -DKEYPLACE_BUILD_EXAMPLES=OFF \
+	  $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
+	@cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzzers
+	@bash tests/fuzz/run_fuzzers.sh $(FUZZ_DIR) $(FUZZ_SECONDS) $(FUZZ_SEED)
 
 # Every bench/*_bench program (docs/BENCHMARKS.md), medians of 3 repetitions.
 bench: build

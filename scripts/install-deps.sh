@@ -18,6 +18,8 @@ packages=(
   python3
   # tests, benchmarks, style
   libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
+  # make fuzz: clang and its libFuzzer and sanitizer runtimes
+  clang libclang-rt-14-dev
   # the report check opens the page in headless Chromium (scripts/check-report.sh)
   chromium
 )

@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,29 @@ std::string Comment(const ConfigFieldInfo& field) {
   return text + field.doc;
 }
 
+// Whether `key` names a section ("place", "place.ransac"), i.e. a mapping may stand there. A
+// mapping anywhere else is refused at once: through an alias to itself (`place: &a {x: *a}`) a
+// mapping nests without end.
+bool IsSection(const std::string& key) {
+  static const std::set<std::string> sections = [] {
+    std::set<std::string> names;
+    for (const auto& field : ConfigKeyValues(Config{})) {
+      for (std::size_t dot = field.first.find('.'); dot != std::string::npos;
+           dot = field.first.find('.', dot + 1)) {
+        names.insert(field.first.substr(0, dot));
+      }
+    }
+    return names;
+  }();
+  return sections.count(key) > 0;
+}
+
+const char* KindOf(const YAML::Node& node) {
+  if (node.IsMap()) return "a mapping";
+  if (node.IsSequence()) return "a list";
+  return node.IsNull() ? "nothing" : "a value";
+}
+
 void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::string& source,
                Config& config) {
   const auto where = [&](const YAML::Node& at) {
@@ -58,9 +82,19 @@ void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::str
                                 ": expected a mapping of keys");
   }
   for (const auto& entry : node) {
-    const std::string key = (prefix.empty() ? "" : prefix + ".") + entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) {
+      throw std::invalid_argument(where(entry.first) +
+                                  (prefix.empty() ? "the configuration" : prefix) +
+                                  ": a key must be a name, found " + KindOf(entry.first));
+    }
+    const std::string key = (prefix.empty() ? "" : prefix + ".") + entry.first.Scalar();
     const YAML::Node& value = entry.second;
     if (value.IsMap()) {
+      if (!IsSection(key)) {
+        throw std::invalid_argument(where(entry.first) + key +
+                                    ": expected a value, found a mapping (not a section of "
+                                    "keyplace dump-config)");
+      }
       ApplyNode(value, key, source, config);
     } else if (value.IsScalar()) {
       try {
@@ -70,7 +104,7 @@ void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::str
       }
     } else {
       throw std::invalid_argument(where(entry.first) + key + ": expected a value, found " +
-                                  (value.IsNull() ? "nothing" : "a list"));
+                                  KindOf(value));
     }
   }
 }

@@ -98,6 +98,19 @@ TEST(Config, BadFilesNameFileLineAndKey) {
             "my.yaml:2: place.min_pairs: expected a value, found a list");
   EXPECT_EQ(ErrorOfYaml("odometry: 3\n"), "my.yaml:1: unknown configuration key 'odometry'");
   EXPECT_EQ(ErrorOfYaml("- 1\n- 2\n"), "my.yaml:1: the configuration: expected a mapping of keys");
+  // Found by fuzzing (tests/fuzz/regressions/config_yaml): a key that is a list or a mapping
+  // ended the program with yaml-cpp's bad conversion; an alias of a mapping inside itself
+  // recursed until the stack overflowed.
+  EXPECT_EQ(ErrorOfYaml("? [a, b]\n: 1\n"),
+            "my.yaml:1: the configuration: a key must be a name, found a list");
+  EXPECT_EQ(ErrorOfYaml("place:\n  {x: 1}: 2\n"),
+            "my.yaml:2: place: a key must be a name, found a mapping");
+  EXPECT_EQ(ErrorOfYaml("place: &loop\n  again: *loop\n"),
+            "my.yaml:2: place.again: expected a value, found a mapping (not a section of "
+            "keyplace dump-config)");
+  EXPECT_EQ(ErrorOfYaml("place:\n  ransac: &r\n    iterations: *r\n"),
+            "my.yaml:3: place.ransac.iterations: expected a value, found a mapping (not a section "
+            "of keyplace dump-config)");
   const std::string malformed = ErrorOfYaml("place:\n  min_pairs: [1, 2\n");
   EXPECT_EQ(malformed.rfind("my.yaml:", 0), 0u) << malformed;
   EXPECT_NE(malformed.find("malformed YAML"), std::string::npos) << malformed;
