@@ -45,10 +45,15 @@ std::string WriteBytes(const std::string& name, const std::string& bytes) {
   return path;
 }
 
+CarmenReadOptions Reading(const BagInputConfig& config) {
+  CarmenReadOptions options;
+  options.bag = config;
+  return options;
+}
+
 std::string ErrorOf(const std::string& path, const BagInputConfig& config) {
   try {
-    ReadCarmenLog(path,
-                  CarmenReadOptions{80.0, 1e7, CarmenReadOptions::PoseKind::kAuto, false, config});
+    ReadCarmenLog(path, Reading(config));
   } catch (const std::invalid_argument& error) {
     return error.what();
   }
@@ -158,8 +163,7 @@ TEST(Ros1Bag, AMessageOfTheWrongTypeOnTheTopicIsNamed) {
 TEST(Ros1Bag, ATruncatedBagIsReadUpToItsLastCompleteChunk) {
   const std::string bytes = ReadBytes(Fr079Bag());
   const std::string cut = WriteBytes("cut.bag", bytes.substr(0, bytes.size() * 6 / 10));
-  const CarmenLog log = ReadCarmenLog(
-      cut, CarmenReadOptions{80.0, 1e7, CarmenReadOptions::PoseKind::kAuto, false, Fr079AsLog()});
+  const CarmenLog log = ReadCarmenLog(cut, Reading(Fr079AsLog()));
   const CarmenLog& whole = Fr079FromBag();
   ASSERT_GT(log.scans.size(), 1000u);
   ASSERT_LT(log.scans.size(), whole.scans.size());
