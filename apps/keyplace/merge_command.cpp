@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include <fmt/core.h>
@@ -67,7 +68,14 @@ void RunMerge(const MergeCommandOptions& options) {
   const Config config = ResolveConfig(options.config);
   const GlobalMap a = LoadMap(options.map_a);
   const GlobalMap b = LoadMap(options.map_b);
-  const MergeResult result = MergeMaps(a, b, config.place, config.merge);
+  // The library names the maps by their logs; the user gave these files.
+  const MergeResult result = [&] {
+    try {
+      return MergeMaps(a, b, config.place, config.merge);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(options.map_b + " into " + options.map_a + ": " + error.what());
+    }
+  }();
   SaveMap(result.merged, options.out_path);
   PrintMerge(options, result);
   if (!options.json_path.empty()) {
