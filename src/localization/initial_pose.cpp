@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "common/config_fields.hpp"
 #include "io/atomic_file.hpp"
 
 namespace keyplace {
@@ -23,12 +23,6 @@ std::array<double, 36> Covariance(const InitialPose& pose) {
   covariance[kY] = pose.position_variance_m2;
   covariance[kYaw] = pose.heading_variance_rad2;
   return covariance;
-}
-
-std::string Shortest(double value) {
-  std::array<char, 32> text{};
-  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
-  return {text.data(), result.ptr};
 }
 
 bool EndsWith(const std::string& text, const std::string& suffix) {
@@ -58,15 +52,17 @@ std::string MessageText(const InitialPose& pose, bool json) {
   const double half_rad = 0.5 * pose.T_map_robot.theta;
   std::string covariance;
   for (const double value : Covariance(pose)) {
-    covariance += (covariance.empty() ? "" : ", ") + Shortest(value);
+    covariance += (covariance.empty() ? "" : ", ") + FormatConfigDouble(value);
   }
   const std::string frame = json ? "\"" + pose.frame_id + "\"" : pose.frame_id;
   return "{" + key("header") + "{" + key("frame_id") + frame + "}, " + key("pose") + "{" +
-         key("pose") + "{" + key("position") + "{" + key("x") + Shortest(pose.T_map_robot.x) +
-         ", " + key("y") + Shortest(pose.T_map_robot.y) + ", " + key("z") + "0.0}, " +
-         key("orientation") + "{" + key("x") + "0.0, " + key("y") + "0.0, " + key("z") +
-         Shortest(std::sin(half_rad)) + ", " + key("w") + Shortest(std::cos(half_rad)) + "}}, " +
-         key("covariance") + "[" + covariance + "]}}\n";
+         key("pose") + "{" + key("position") + "{" + key("x") +
+         FormatConfigDouble(pose.T_map_robot.x) + ", " + key("y") +
+         FormatConfigDouble(pose.T_map_robot.y) + ", " + key("z") + "0.0}, " + key("orientation") +
+         "{" + key("x") + "0.0, " + key("y") + "0.0, " + key("z") +
+         FormatConfigDouble(std::sin(half_rad)) + ", " + key("w") +
+         FormatConfigDouble(std::cos(half_rad)) + "}}, " + key("covariance") + "[" + covariance +
+         "]}}\n";
 }
 
 }  // namespace
