@@ -6,6 +6,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "mapping/map_numbering.hpp"
+
 namespace keyplace {
 namespace {
 
@@ -38,33 +40,11 @@ Extent ExtentOf(const GlobalMap& map) {
   return {0.5 * (low + high), 0.5 * (high - low).norm()};
 }
 
-// The ids and scan indices a map uses (scans 0..-1 when it has none).
-struct Numbering {
-  int first_id = std::numeric_limits<int>::max();
-  int last_id = -1;
-  int first_scan = std::numeric_limits<int>::max();
-  int last_scan = -1;
-};
-
-Numbering NumberingOf(const GlobalMap& map) {
-  Numbering numbering;
-  for (const Submap& submap : map.submaps) {
-    numbering.first_id = std::min(numbering.first_id, submap.id);
-    numbering.last_id = std::max(numbering.last_id, submap.id);
-    for (const int scan : submap.scan_indices) {
-      numbering.first_scan = std::min(numbering.first_scan, scan);
-      numbering.last_scan = std::max(numbering.last_scan, scan);
-    }
-  }
-  if (numbering.last_scan < 0) numbering.first_scan = 0;
-  return numbering;
-}
-
 // A distractor map with what every copy of it needs.
 struct Source {
   const GlobalMap* map;
   Extent extent;
-  Numbering numbering;
+  MapNumbering numbering;
 };
 
 // Where the copies go: tile 0 holds the map, copy k tile k + 1 of a square lattice (row-major).
@@ -133,7 +113,7 @@ GlobalMap EmbedAmongDistractors(const GlobalMap& map, const std::vector<GlobalMa
   std::uniform_real_distribution<double> heading(-M_PI, M_PI);
 
   result.submaps.reserve(options.total_submaps);
-  const Numbering own = NumberingOf(map);
+  const MapNumbering own = NumberingOf(map);
   int next_id = own.last_id + 2;
   int next_scan = std::max(own.last_scan + 1, options.first_scan);
   for (std::size_t copy = 0; copy < copies; ++copy) {

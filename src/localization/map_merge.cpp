@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "keyplace/place/place_recognizer.hpp"
+#include "mapping/map_numbering.hpp"
 
 namespace keyplace {
 namespace {
@@ -88,29 +89,14 @@ Pose2 FitTransform(const std::vector<Candidate>& candidates,
   return {translation.x(), translation.y(), T_rotation.theta};
 }
 
-GlobalMap Joined(const GlobalMap& a, const GlobalMap& b_in_a) {
+// B is taken by value: its submaps move into the result instead of being copied a second time.
+GlobalMap Joined(const GlobalMap& a, GlobalMap b_in_a) {
   GlobalMap merged = a;
-  int last_id = 0;
-  int last_scan = -1;
-  for (const Submap& submap : a.submaps) {
-    last_id = std::max(last_id, submap.id);
-    for (const int scan : submap.scan_indices) last_scan = std::max(last_scan, scan);
-  }
-  int first_id = 0;
-  int first_scan = 0;
-  if (!b_in_a.submaps.empty()) {
-    first_id = b_in_a.submaps.front().id;
-    first_scan = b_in_a.submaps.front().first_scan();
-    for (const Submap& submap : b_in_a.submaps) {
-      first_id = std::min(first_id, submap.id);
-      for (const int scan : submap.scan_indices) first_scan = std::min(first_scan, scan);
-    }
-  }
-  // B's ids start at the second thousand after A's: a gap wider than any verification reach
-  // (place.verification_neighbours), so no B submap is ever a map neighbour of an A submap.
-  const int id_offset = (last_id / kIdBlock + 2) * kIdBlock - first_id;
-  const int scan_offset = last_scan + 1 - first_scan;
-  for (Submap submap : b_in_a.submaps) {
+  const MapNumbering numbering_a = NumberingOf(a);
+  const MapNumbering numbering_b = NumberingOf(b_in_a);
+  const int id_offset = (numbering_a.last_id / kIdBlock + 2) * kIdBlock - numbering_b.first_id;
+  const int scan_offset = numbering_a.last_scan + 1 - numbering_b.first_scan;
+  for (Submap& submap : b_in_a.submaps) {
     submap.id += id_offset;
     for (int& scan : submap.scan_indices) scan += scan_offset;
     for (StableKeypoint& keypoint : submap.keypoints) keypoint.scan_index += scan_offset;
