@@ -4,11 +4,13 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -80,17 +82,19 @@ bool WriteAll(int fd, const std::string& text) {
 }
 
 // Writes kGeneratedScans FLASER lines of 360 beams into fd, 64 lines per write, then closes it;
-// stops when the reader has gone.
-void WriteGeneratedLog(int fd) {
-  std::string beams = "FLASER 360";
-  for (int beam = 0; beam < 360; ++beam) beams += " 2.50";
-  std::string batch;
+// stops when the reader has gone. It allocates nothing: the address-space limit applies to the
+// whole process, and a std::bad_alloc here would end the test in std::terminate instead of
+// showing the reader's behaviour. `batch` is reserved before the limit is set.
+void WriteGeneratedLog(int fd, const std::string& beams, std::string& batch) {
+  constexpr const char* kOdometry = " 1.0 2.0 0.5 1.0 2.0 0.5 ";
+  std::array<char, 32> stamp{};
   for (std::size_t scan = 0; scan < kGeneratedScans; ++scan) {
-    const std::string stamp = std::to_string(1000.0 + 0.1 * static_cast<double>(scan));
-    batch += beams + " 1.0 2.0 0.5 1.0 2.0 0.5 " + stamp + " host " + stamp + "\n";
+    std::snprintf(stamp.data(), stamp.size(), "%.6f", 1000.0 + 0.1 * static_cast<double>(scan));
+    batch.append(beams).append(kOdometry).append(stamp.data()).append(" host ");
+    batch.append(stamp.data()).push_back('\n');
     if (scan % 64 == 63 || scan + 1 == kGeneratedScans) {
       if (!WriteAll(fd, batch)) break;
-      batch.clear();
+      batch.clear();  // keeps its capacity
     }
   }
   close(fd);
@@ -102,7 +106,12 @@ void WriteGeneratedLog(int fd) {
   std::signal(SIGPIPE, SIG_IGN);
   int fds[2];
   if (pipe(fds) != 0) std::exit(2);
-  std::thread writer(WriteGeneratedLog, fds[1]);  // its stack exists before the limit
+  std::string beams = "FLASER 360";
+  for (int beam = 0; beam < 360; ++beam) beams += " 2.50";
+  std::string batch;
+  batch.reserve(64 * (beams.size() + 128));
+  // The writer's stack and buffers exist before the limit.
+  std::thread writer(WriteGeneratedLog, fds[1], std::cref(beams), std::ref(batch));
   rlimit limit{};
   limit.rlim_cur = limit.rlim_max = VirtualMemoryBytes() + kHeadroomBytes;
   if (setrlimit(RLIMIT_AS, &limit) != 0) std::exit(2);
