@@ -41,6 +41,11 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
     table.Int("min_pairs", &C::min_pairs, "", "mu: unique descriptor pairs for a candidate submap")
         .Int("max_candidates", &C::max_candidates, "",
              "n_c: candidates verified, by increasing mean pair distance")
+        .Enum("candidate_ranking", &C::candidate_ranking,
+              {{C::CandidateRanking::kMeanDistance, "mean_distance"},
+               {C::CandidateRanking::kRigidPairs, "rigid_pairs"}},
+              "which n_c of more candidates are verified: smallest mean pair distance (paper) or "
+              "most pairs agreeing with one rigid transform")
         .Double("descriptor_match_chi2", &C::descriptor_match_chi2, "",
                 "a descriptor pair: symmetric chi2 below this")
         .Enum("pair_matching", &C::pair_matching,
@@ -114,6 +119,7 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints;
   config.min_gamma_all_scans = 0.4;     // unused: stable query keypoints
   config.min_reference_coverage = 0.0;  // unused: stable query keypoints
+  config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kMeanDistance;
   return config;
 }
 

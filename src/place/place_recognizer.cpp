@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "keyplace/place/ransac.hpp"
+#include "place/candidate_ranking.hpp"
 #include "place/descriptor_index.hpp"
 
 namespace keyplace {
@@ -416,13 +417,29 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
       candidates.begin(), candidates.end(),
       [](const Candidate& a, const Candidate& b) { return a.mean_distance < b.mean_distance; });
   match.candidates = static_cast<int>(candidates.size());
+  const auto max_candidates = static_cast<std::size_t>(config_.max_candidates);
+  if (candidates.size() > max_candidates &&
+      config_.candidate_ranking == PlaceRecognitionConfig::CandidateRanking::kRigidPairs) {
+    std::vector<int> rigid_star;
+    rigid_star.reserve(candidates.size());
+    for (const Candidate& candidate : candidates) {
+      rigid_star.push_back(LargestRigidStar(candidate.pairs, *match_positions,
+                                            places_[candidate.place_index].positions,
+                                            config_.ransac.rigidity_m2));
+    }
+    std::vector<Candidate> kept;
+    kept.reserve(max_candidates);
+    for (std::size_t k : KeepMostRigid(rigid_star, max_candidates)) {
+      kept.push_back(std::move(candidates[k]));
+    }
+    candidates = std::move(kept);
+  }
   match.seconds_pairing = SecondsSince(start);
 
   // Geometric verification of the first n_c candidates.
   const auto verify_start = Clock::now();
   RansacConfig ransac = config_.ransac;
-  const std::size_t to_verify =
-      std::min(candidates.size(), static_cast<std::size_t>(config_.max_candidates));
+  const std::size_t to_verify = std::min(candidates.size(), max_candidates);
   std::vector<std::pair<int, int>> index_pairs;
   std::vector<Eigen::Vector2d> extended_positions;
   std::vector<BetaGridDescriptor> extended_descriptors;

@@ -4,6 +4,8 @@
 #include <limits>
 #include <random>
 
+#include "place/nearest_reference.hpp"
+
 namespace keyplace {
 namespace {
 
@@ -50,32 +52,28 @@ Pose2 FitRigidTransform(const std::vector<Eigen::Vector2d>& reference,
   return {mean_ref.x() - rotated.x(), mean_ref.y() - rotated.y(), angle};
 }
 
+namespace {
+
+// ScoreTransform against reference keypoints already sorted for the inlier search.
+double ScoreAgainst(const NearestReference& reference, const std::vector<Eigen::Vector2d>& current,
+                    const Pose2& T_ref_cur, std::vector<std::pair<int, int>>* inliers) {
+  if (inliers) inliers->clear();
+  if (current.empty()) return 0.0;
+  double score = 0.0;
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    const auto [nearest, distance2] = reference.Nearest(T_ref_cur * current[i]);
+    if (nearest >= 0 && inliers) inliers->emplace_back(static_cast<int>(i), nearest);
+    score += distance2;  // the threshold^2 when there is no inlier: the truncated (MSAC) cost
+  }
+  return score / static_cast<double>(current.size());
+}
+
+}  // namespace
+
 double ScoreTransform(const std::vector<Eigen::Vector2d>& reference,
                       const std::vector<Eigen::Vector2d>& current, const Pose2& T_ref_cur,
                       double inlier_distance_m, std::vector<std::pair<int, int>>* inliers) {
-  if (inliers) inliers->clear();
-  if (current.empty()) return 0.0;
-  const double threshold2 = inlier_distance_m * inlier_distance_m;
-  double score = 0.0;
-  for (std::size_t i = 0; i < current.size(); ++i) {
-    const Eigen::Vector2d point = T_ref_cur * current[i];
-    double best = std::numeric_limits<double>::infinity();
-    int best_index = -1;
-    for (std::size_t j = 0; j < reference.size(); ++j) {
-      const double d2 = (point - reference[j]).squaredNorm();
-      if (d2 < best) {
-        best = d2;
-        best_index = static_cast<int>(j);
-      }
-    }
-    if (best < threshold2) {
-      if (inliers) inliers->emplace_back(static_cast<int>(i), best_index);
-      score += best;
-    } else {
-      score += threshold2;
-    }
-  }
-  return score / static_cast<double>(current.size());
+  return ScoreAgainst(NearestReference(reference, inlier_distance_m), current, T_ref_cur, inliers);
 }
 
 RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& reference,
@@ -88,6 +86,7 @@ RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& re
   if (n < 2) return result;
 
   std::vector<std::pair<int, int>> inliers;
+  const NearestReference nearest_reference(reference, config.inlier_distance_m);
   auto try_hypothesis = [&](int a, int b) {
     const Eigen::Vector2d& c1 = current[pairs[a].first];
     const Eigen::Vector2d& c2 = current[pairs[b].first];
@@ -99,8 +98,7 @@ RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& re
     if ((d_cur - d_ref) * (d_cur - d_ref) / (8.0 * (d_cur + d_ref)) > config.rigidity_m2) return;
     const Pose2 hypothesis = HypothesisFromTwoPairs(c1, c2, r1, r2);
     ++result.hypotheses;
-    const double score =
-        ScoreTransform(reference, current, hypothesis, config.inlier_distance_m, &inliers);
+    const double score = ScoreAgainst(nearest_reference, current, hypothesis, &inliers);
     if (score < result.score) {
       result.score = score;
       result.T_ref_cur = hypothesis;
@@ -134,8 +132,7 @@ RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& re
       ref_points.push_back(reference[r]);
     }
     const Pose2 refined = FitRigidTransform(ref_points, cur_points);
-    const double score =
-        ScoreTransform(reference, current, refined, config.inlier_distance_m, &inliers);
+    const double score = ScoreAgainst(nearest_reference, current, refined, &inliers);
     if (score <= result.score) {
       result.score = score;
       result.T_ref_cur = refined;

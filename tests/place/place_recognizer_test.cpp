@@ -111,6 +111,36 @@ TEST(PlaceRecognizer, ExhaustiveMatchesBruteForceCandidateCount) {
   EXPECT_EQ(match.place_id, 3);
 }
 
+TEST(PlaceRecognizer, RigidPairRankingVerifiesTheRightPlaceWhenCandidatesExceedTheCap) {
+  // Place 0 has the target's descriptors at unrelated positions: it pairs with the query as well
+  // as the target and comes first by mean pair distance (all distances are 0, ties keep the map
+  // order), but no rigid transform explains its pairs.
+  std::vector<Place> places = MakePlaces(2, 25, 21);
+  places[0].descriptors = places[1].descriptors;
+  const PlaceQuery query = MakeQuery(places[1], Pose2(1.0, -0.5, 0.7), 5, 8, 77);
+  PlaceRecognitionConfig config;
+  config.max_candidates = 1;
+  config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kMeanDistance;
+  const PlaceMatch by_distance = PlaceRecognizer(places, config).Recognize(query);
+  EXPECT_EQ(by_distance.candidates, 2);
+  EXPECT_EQ(by_distance.candidates_verified, 1);
+  EXPECT_FALSE(by_distance.verified);
+  config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kRigidPairs;
+  const PlaceMatch by_rigidity = PlaceRecognizer(places, config).Recognize(query);
+  EXPECT_EQ(by_rigidity.candidates_verified, 1);
+  ASSERT_TRUE(by_rigidity.found);
+  EXPECT_EQ(by_rigidity.place_id, 1);
+  // Under the cap the ranking changes nothing.
+  config.max_candidates = 2;
+  const PlaceMatch all = PlaceRecognizer(places, config).Recognize(query);
+  config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kMeanDistance;
+  const PlaceMatch all_by_distance = PlaceRecognizer(places, config).Recognize(query);
+  EXPECT_EQ(all.place_id, 1);
+  EXPECT_EQ(all.place_id, all_by_distance.place_id);
+  EXPECT_EQ(all.consensus, all_by_distance.consensus);
+  EXPECT_EQ(all.score, all_by_distance.score);
+}
+
 TEST(PlaceRecognizer, AllScanKeypointsRecoverAQueryWithTooFewStableOnes) {
   // The query's stable keypoints are too few for mu pairs; the keypoints of all its scans (each
   // place keypoint seen twice, a few mm apart) are enough, and merging removes the duplicates.

@@ -14,8 +14,15 @@ namespace keyplace {
 
 struct PlaceRecognitionConfig {
   // --- submap matching (Algorithm 3)
-  int min_pairs = 10;                  // mu: unique descriptor pairs for a candidate
-  int max_candidates = 500;            // n_c: candidates verified, by increasing mean pair distance
+  int min_pairs = 10;        // mu: unique descriptor pairs for a candidate
+  int max_candidates = 500;  // n_c: candidates verified, by increasing mean pair distance
+  // Which n_c candidates are verified when there are more. kMeanDistance: the n_c with the
+  // smallest mean pair distance (the paper). kRigidPairs: the n_c whose descriptor pairs agree
+  // best with one rigid transform (LargestRigidStar in src/place/candidate_ranking.hpp, ties by
+  // mean distance). Either way the chosen ones are verified by increasing mean pair distance, so
+  // with n_c or fewer candidates both give the same answer (docs/PLACE.md, "Candidate ranking").
+  enum class CandidateRanking { kMeanDistance, kRigidPairs };
+  CandidateRanking candidate_ranking = CandidateRanking::kRigidPairs;
   double descriptor_match_chi2 = 0.4;  // a descriptor pair: symmetric chi2 below this
   // How "FindUniqueMatch" pairs keypoints, each used at most once. kQueryOrder: every query
   // keypoint in turn takes its nearest still-unused reference keypoint (Algorithm 3 read
