@@ -5,6 +5,7 @@
 // Nested structs (e.g. PlaceRecognitionConfig::ransac) join with a dotted prefix.
 
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -47,7 +48,11 @@ class ConfigFields {
     return Add(
         {name, unit, doc}, [member](const Config& c) { return FormatConfigDouble(c.*member); },
         [member](const std::string& text, Config& c) {
-          c.*member = ParseNumber<double>(text, "a number");
+          const double value = ParseNumber<double>(text, "a number");
+          // No setting means "unlimited" by infinity (0 switches things off), and an infinite
+          // size or distance would only fail later, as an allocation or a NaN far from here.
+          if (!std::isfinite(value)) throw std::invalid_argument("'" + text + "' is not finite");
+          c.*member = value;
         });
   }
 

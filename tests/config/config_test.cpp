@@ -1,5 +1,6 @@
 #include "keyplace/config/config.hpp"
 
+#include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -84,8 +85,7 @@ TEST(Config, BadFilesNameFileLineAndKey) {
             "my.yaml:2: mapping.cell_size_m: MappingConfig.cell_size_m must lie in [0.01, 10] m "
             "(docs/MAPPING.md)");
   EXPECT_EQ(ErrorOfYaml("mapping:\n  cell_size_m: inf\n"),
-            "my.yaml:2: mapping.cell_size_m: MappingConfig.cell_size_m must lie in [0.01, 10] m "
-            "(docs/MAPPING.md)");
+            "my.yaml:2: mapping.cell_size_m: 'inf' is not finite");
   EXPECT_EQ(ErrorOfYaml("place:\n  min_gamma: 1.5\n"),
             "my.yaml:2: place.min_gamma: PlaceRecognitionConfig.min_gamma must lie in [0, 1]");
   EXPECT_EQ(ErrorOfYaml("slam:\n  loop_refinement:\n    refine: maybe\n"),
@@ -131,6 +131,28 @@ TEST(Config, AssignmentsAndFilesReportTheirErrors) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("/nonexistent/config.yaml"), std::string::npos);
   }
+}
+
+TEST(Config, NoNumberFieldTakesInfinityOrNaN) {
+  int number_fields = 0;
+  for (const ConfigFieldInfo& field : DescribeConfig(Config{})) {
+    char* end = nullptr;
+    std::strtod(field.default_value.c_str(), &end);
+    if (field.default_value.empty() || *end != '\0') continue;  // enums, switches, text
+    ++number_fields;
+    for (const char* value : {"inf", "-inf", "nan", "infinity"}) {
+      Config config;
+      try {
+        ApplyConfigAssignment(field.key + "=" + value, config);
+        ADD_FAILURE() << field.key << "=" << value << " was accepted";
+      } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find(field.key.substr(field.key.find('.') + 1)),
+                  std::string::npos)
+            << error.what();
+      }
+    }
+  }
+  EXPECT_GT(number_fields, 80);
 }
 
 TEST(Config, SlamAndLocalizerTakeTheSharedSections) {
