@@ -17,7 +17,20 @@ nlohmann::json RelationJson(const RelationErrorReport& r) {
   json["relations"] = r.relations;
   json["matched"] = r.matched;
   json["unmatched"] = r.unmatched;
+  json["outside_span"] = r.outside_span;
   json["duplicate_timestamps"] = r.duplicate_timestamps;
+  if (!r.refusal.empty()) {  // no error figures at all, so no script can read one by mistake
+    json["refusal"] = r.refusal;
+    for (const char* key :
+         {"translation_mean_m", "translation_std_m", "rotation_mean_deg", "rotation_std_deg",
+          "local_translation_mean_m", "local_translation_std_m", "local_rotation_mean_deg",
+          "local_rotation_std_deg", "loop_translation_mean_m", "loop_translation_std_m",
+          "loop_rotation_mean_deg", "loop_rotation_std_deg", "all", "local", "loop"}) {
+      json[key] = nullptr;
+    }
+    return json;
+  }
+  json["refusal"] = nullptr;
   // Flat keys for scripts, then the full statistics per split.
   json["translation_mean_m"] = r.all.translation_mean_m;
   json["translation_std_m"] = r.all.translation_std_m;
@@ -35,6 +48,11 @@ nlohmann::json RelationJson(const RelationErrorReport& r) {
   json["local"] = StatsJson(r.local);
   json["loop"] = StatsJson(r.loop);
   return json;
+}
+
+std::string OutsideSpanNote(const RelationErrorReport& report) {
+  if (report.outside_span == 0) return "";
+  return ", " + std::to_string(report.outside_span) + " outside the log's time span";
 }
 
 }  // namespace keyplace::cli

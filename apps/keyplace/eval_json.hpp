@@ -1,5 +1,7 @@
 #pragma once
-// JSON forms of evaluation results shared by several subcommands.
+// JSON (and short text) forms of evaluation results shared by several subcommands.
+
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -11,7 +13,11 @@ namespace keyplace::cli {
 nlohmann::json StatsJson(const ErrorStats& stats);
 
 /// The Kümmerle relation error: flat keys for scripts (translation_mean_m, local_*, loop_*) and
-/// the full statistics of each split under "all", "local" and "loop".
+/// the full statistics of each split under "all", "local" and "loop"; all of them null, and
+/// "refusal" saying why, when too few relations matched.
 nlohmann::json RelationJson(const RelationErrorReport& report);
+
+/// ", N outside the log's time span" when relations were left out for that, else "".
+std::string OutsideSpanNote(const RelationErrorReport& report);
 
 }  // namespace keyplace::cli

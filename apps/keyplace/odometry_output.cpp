@@ -20,7 +20,12 @@ void PrintStatsRow(const std::string& label, const ErrorStats& s) {
 }
 
 void PrintRelations(const std::string& name, const RelationErrorReport& r) {
-  fmt::print("{} relation error ({} of {} relations matched):\n", name, r.matched, r.relations);
+  if (!r.refusal.empty()) {
+    fmt::print("{} relation error: none, {}\n", name, r.refusal);
+    return;
+  }
+  fmt::print("{} relation error ({} of {} relations matched{}):\n", name, r.matched, r.relations,
+             OutsideSpanNote(r));
   PrintStatsRow("all", r.all);
   PrintStatsRow("local", r.local);
   PrintStatsRow("loop", r.loop);

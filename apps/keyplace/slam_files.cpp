@@ -41,6 +41,13 @@ void AddLoopJson(const SlamReport& r, nlohmann::json& json) {
   json["precision_overlap_30_common_area"] = p.common_area_30;
   json["overlap_histogram_common_area"] = e.histogram_common.counts;
   json["overlap_histogram"] = e.histogram.counts;
+  // A share of no loops is not 0 (issue 17): without loops every precision is null.
+  if (r.run.slam->loops().empty()) {
+    for (auto& [key, value] : json.items()) {
+      if (key.rfind("precision_", 0) == 0) value = nullptr;
+    }
+  }
+  if (e.loops.used_count == 0) json["precision_overlap_30_used"] = nullptr;
 }
 
 void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
@@ -65,6 +72,12 @@ void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
                               {"ransac_translation_mean_m", ev.paired_ransac_m},
                               {"ransac_rotation_mean_deg", ev.paired_ransac_deg}};
   json["precision_truth"] = ev.precision_truth();
+  if (ev.truth_evaluated == 0) json["precision_truth"] = nullptr;
+  if (ev.paired_loops == 0) {
+    for (auto& [key, value] : json["loop_truth_error"].items()) {
+      if (key != "loops") value = nullptr;
+    }
+  }
 }
 
 void AddMapAndTimeJson(const SlamReport& r, double total_seconds, nlohmann::json& json) {

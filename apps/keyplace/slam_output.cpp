@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "eval_json.hpp"
 #include "paper_tables.hpp"
 #include "slam_figures.hpp"
 
@@ -22,8 +23,13 @@ void PrintLoopCounts(const SlamReport& r) {
              r.run.slam->loops().size(), s.loops_accepted, ev.used_count);
   fmt::print(
       "loop refinement    {} refined by ICP, {} with a neighbour of the matched submap as "
-      "partner; precision at 30 % before refinement and partner choice {:.3f}\n",
-      s.loops_refined, s.loops_partner_changed, p.matched_ransac_30);
+      "partner",
+      s.loops_refined, s.loops_partner_changed);
+  if (!r.run.slam->loops().empty()) {
+    fmt::print("; precision at 30 % before refinement and partner choice {:.3f}",
+               p.matched_ransac_30);
+  }
+  fmt::print("\n");
   const double min_point_overlap = r.config.slam.loop_refinement.min_point_overlap;
   if (min_point_overlap > 0.0) {
     fmt::print(
@@ -37,6 +43,10 @@ void PrintLoopCounts(const SlamReport& r) {
 void PrintLoopPrecision(const SlamReport& r) {
   const LoopEvaluation& ev = r.evaluation.loops;
   const LoopPrecisions& p = r.evaluation.precision;
+  if (r.run.slam->loops().empty()) {
+    fmt::print("loop precision     no loops\n");
+    return;
+  }
   fmt::print("loop precision     {:.3f} at 10 % overlap, {:.3f} at 30 % ({:.3f} of the used)\n",
              p.overlap_10, p.overlap_30, p.used_overlap_30);
   fmt::print("                   {:.3f} at 30 % with 0.2 m cells (sensitivity of the measure)\n",
@@ -46,11 +56,19 @@ void PrintLoopPrecision(const SlamReport& r) {
       "observed\n",
       p.common_area_10, p.common_area_30);
   if (!r.evaluation.has_truth) return;
+  if (ev.truth_evaluated == 0) {
+    fmt::print(
+        "                   no loop can be checked against ground truth (none within {} "
+        "scans of a corrected scan)\n",
+        r.evaluation.truth_max_gap_scans);
+    return;
+  }
   fmt::print(
       "                   {:.3f} against ground truth (0.5 m, 10 deg): {} of {} loops whose "
       "submap origins are at most {} scans from a corrected scan (mean {:.1f})\n",
       ev.precision_truth(), ev.truth_correct, ev.truth_evaluated, r.evaluation.truth_max_gap_scans,
       ev.truth_mean_gap_scans);
+  if (ev.paired_loops == 0) return;
   fmt::print(
       "                   loop transform error against ground truth, mean over {} loops: "
       "{:.3f} m / {:.2f} deg (place recognition's RANSAC estimate: {:.3f} m / {:.2f} deg)\n",
@@ -125,15 +143,17 @@ void PrintAccuracy(const SlamEvaluation& e) {
     }
     fmt::print("\n");
   }
-  if (e.relations && e.relations_icp) {
+  if (e.relations && !e.relations->refusal.empty()) {
+    fmt::print("relations: no relation error, {}\n", e.relations->refusal);
+  } else if (e.relations && e.relations_icp) {
     const RelationErrorReport& r = *e.relations;
     const ErrorStats& i = e.relations_icp->all;
     fmt::print(
-        "relations ({} of {}): SLAM {:.4f} ± {:.4f} m, {:.3f} ± {:.3f} deg; ICP odometry "
+        "relations ({} of {}{}): SLAM {:.4f} ± {:.4f} m, {:.3f} ± {:.3f} deg; ICP odometry "
         "{:.4f} ± {:.4f} m, {:.3f} ± {:.3f} deg\n",
-        r.matched, r.relations, r.all.translation_mean_m, r.all.translation_std_m,
-        r.all.rotation_mean_deg, r.all.rotation_std_deg, i.translation_mean_m, i.translation_std_m,
-        i.rotation_mean_deg, i.rotation_std_deg);
+        r.matched, r.relations, OutsideSpanNote(r), r.all.translation_mean_m,
+        r.all.translation_std_m, r.all.rotation_mean_deg, r.all.rotation_std_deg,
+        i.translation_mean_m, i.translation_std_m, i.rotation_mean_deg, i.rotation_std_deg);
   }
 }
 

@@ -90,6 +90,10 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
     table
         .Double("local_relation_max_dt_s", &C::local_relation_max_dt_s, "s",
                 "relations with |t_b - t_a| below this are local, the others loop")
+        .Double("relation_stamp_tolerance_s", &C::relation_stamp_tolerance_s, "s",
+                "a relation stamp matches the scan with the nearest stamp within this")
+        .Double("min_matched_relations", &C::min_matched_relations, "",
+                "no relation error when fewer than this fraction of the relations matched")
         .Int("truth_max_gap_scans", &C::truth_max_gap_scans, "",
              "slam loops are checked when their origins are this close to a corrected scan")
         .Double("revisit_radius_m", &C::revisit_radius_m, "m",
@@ -110,6 +114,12 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
 void Validate(const EvaluationConfig& config) {
   if (!(config.local_relation_max_dt_s > 0.0)) {
     throw std::invalid_argument("EvaluationConfig.local_relation_max_dt_s must be positive");
+  }
+  if (!(config.relation_stamp_tolerance_s >= 0.0 && config.relation_stamp_tolerance_s <= 1.0)) {
+    throw std::invalid_argument("EvaluationConfig.relation_stamp_tolerance_s must lie in [0, 1] s");
+  }
+  if (!(config.min_matched_relations >= 0.0 && config.min_matched_relations <= 1.0)) {
+    throw std::invalid_argument("EvaluationConfig.min_matched_relations must lie in [0, 1]");
   }
   if (config.truth_max_gap_scans < 0) {
     throw std::invalid_argument("EvaluationConfig.truth_max_gap_scans must be >= 0");

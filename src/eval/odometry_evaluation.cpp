@@ -128,8 +128,7 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
 OdometryRelationErrors EvaluateOdometryRelations(const OdometryRun& run,
                                                  const std::vector<Relation>& relations,
                                                  const EvaluationConfig& config) {
-  RelationErrorConfig relation_config;
-  relation_config.local_max_dt_s = config.local_relation_max_dt_s;
+  const RelationErrorConfig relation_config = RelationConfigFrom(config);
   return {EvaluateRelations(run.icp_trajectory, relations, relation_config),
           EvaluateRelations(run.odometry_trajectory, relations, relation_config)};
 }

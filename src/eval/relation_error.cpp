@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 namespace keyplace {
 namespace {
@@ -23,7 +26,93 @@ void MeanStdMax(const std::vector<double>& values, double* mean, double* std_dev
   *max = *std::max_element(values.begin(), values.end());
 }
 
+void ValidateRelationConfig(const RelationErrorConfig& config) {
+  if (!(config.local_max_dt_s >= 0.0)) {
+    throw std::invalid_argument("RelationErrorConfig.local_max_dt_s must be >= 0");
+  }
+  if (!(config.stamp_tolerance_s >= 0.0 && config.stamp_tolerance_s <= 1.0)) {
+    throw std::invalid_argument("RelationErrorConfig.stamp_tolerance_s must lie in [0, 1] s");
+  }
+  if (!(config.min_matched_fraction >= 0.0 && config.min_matched_fraction <= 1.0)) {
+    throw std::invalid_argument("RelationErrorConfig.min_matched_fraction must lie in [0, 1]");
+  }
+}
+
+// The trajectory's stamps in increasing order (equal stamps in trajectory order), for matching
+// relation stamps by value.
+class StampIndex {
+ public:
+  explicit StampIndex(const std::vector<TimedPose>& trajectory) {
+    order_.resize(trajectory.size());
+    for (std::size_t i = 0; i < trajectory.size(); ++i) order_[i] = i;
+    std::stable_sort(order_.begin(), order_.end(), [&trajectory](std::size_t a, std::size_t b) {
+      return trajectory[a].timestamp_s < trajectory[b].timestamp_s;
+    });
+    stamps_.reserve(order_.size());
+    for (std::size_t i : order_) stamps_.push_back(trajectory[i].timestamp_s);
+    for (std::size_t k = 1; k < stamps_.size(); ++k) duplicates_ += stamps_[k] == stamps_[k - 1];
+  }
+
+  std::size_t duplicates() const { return duplicates_; }
+
+  // Whether `stamp_s` lies within the first..last stamp, widened by the tolerance.
+  bool Spans(double stamp_s, double tolerance_s) const {
+    return !stamps_.empty() && stamp_s >= stamps_.front() - tolerance_s &&
+           stamp_s <= stamps_.back() + tolerance_s;
+  }
+
+  // The trajectory index of the nearest stamp within tolerance_s; ties go to the earlier stamp,
+  // and among equal stamps to the earlier pose.
+  std::optional<std::size_t> Nearest(double stamp_s, double tolerance_s) const {
+    const auto above = std::lower_bound(stamps_.begin(), stamps_.end(), stamp_s);
+    auto nearest = stamps_.end();
+    double gap_s = std::numeric_limits<double>::infinity();
+    if (above != stamps_.begin()) {
+      nearest = std::lower_bound(stamps_.begin(), above, *std::prev(above));  // first of equals
+      gap_s = stamp_s - *nearest;
+    }
+    if (above != stamps_.end() && *above - stamp_s < gap_s) {
+      nearest = above;
+      gap_s = *above - stamp_s;
+    }
+    if (nearest == stamps_.end() || !(gap_s <= tolerance_s)) return std::nullopt;
+    return order_[static_cast<std::size_t>(nearest - stamps_.begin())];
+  }
+
+ private:
+  std::vector<std::size_t> order_;  // trajectory indices by stamp
+  std::vector<double> stamps_;      // their stamps
+  std::size_t duplicates_ = 0;
+};
+
+std::string RefusalOf(const RelationErrorReport& report, const RelationErrorConfig& config) {
+  const std::size_t inside = report.matched + report.unmatched;
+  if (report.relations == 0) return "the relation file holds no relation";
+  if (inside == 0) {
+    return "no relation lies within the trajectory's time span (" +
+           std::to_string(report.outside_span) +
+           " outside it): the relation file belongs to another log";
+  }
+  const double fraction = static_cast<double>(report.matched) / static_cast<double>(inside);
+  if (fraction >= config.min_matched_fraction) return "";
+  char numbers[96];
+  std::snprintf(numbers, sizeof(numbers),
+                " (%.1f %%) matched a scan stamp within %g ms, below %g %%", 100.0 * fraction,
+                1e3 * config.stamp_tolerance_s, 100.0 * config.min_matched_fraction);
+  return "only " + std::to_string(report.matched) + " of the " + std::to_string(inside) +
+         " relations inside the trajectory's time span" + numbers +
+         ": the relation file belongs to another log, or its stamps differ from the log's";
+}
+
 }  // namespace
+
+RelationErrorConfig RelationConfigFrom(const EvaluationConfig& config) {
+  RelationErrorConfig relation_config;
+  relation_config.local_max_dt_s = config.local_relation_max_dt_s;
+  relation_config.stamp_tolerance_s = config.relation_stamp_tolerance_s;
+  relation_config.min_matched_fraction = config.min_matched_relations;
+  return relation_config;
+}
 
 ErrorStats Summarize(const std::vector<double>& translation_errors_m,
                      const std::vector<double>& rotation_errors_deg) {
@@ -48,24 +137,22 @@ PoseError RelativePoseError(const Pose2& estimated_T_a_b, const Pose2& true_T_a_
 RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
                                       const std::vector<Relation>& relations,
                                       const RelationErrorConfig& config) {
-  if (!(config.local_max_dt_s >= 0.0)) {
-    throw std::invalid_argument("RelationErrorConfig.local_max_dt_s must be >= 0");
-  }
+  ValidateRelationConfig(config);
   RelationErrorReport report;
   report.relations = relations.size();
-  std::unordered_map<std::int64_t, std::size_t> by_key;
-  by_key.reserve(trajectory.size() * 2);
-  for (std::size_t i = 0; i < trajectory.size(); ++i) {
-    if (!by_key.emplace(TimestampKey(trajectory[i].timestamp_s), i).second) {
-      ++report.duplicate_timestamps;
-    }
-  }
+  const StampIndex stamps(trajectory);
+  report.duplicate_timestamps = stamps.duplicates();
   std::vector<double> t_all, r_all, t_local, r_local, t_loop, r_loop;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
-    const auto a = by_key.find(TimestampKey(relation.timestamp_a_s));
-    const auto b = by_key.find(TimestampKey(relation.timestamp_b_s));
-    if (a == by_key.end() || b == by_key.end()) {
+    if (!stamps.Spans(relation.timestamp_a_s, config.stamp_tolerance_s) ||
+        !stamps.Spans(relation.timestamp_b_s, config.stamp_tolerance_s)) {
+      ++report.outside_span;
+      continue;
+    }
+    const auto a = stamps.Nearest(relation.timestamp_a_s, config.stamp_tolerance_s);
+    const auto b = stamps.Nearest(relation.timestamp_b_s, config.stamp_tolerance_s);
+    if (!a || !b) {
       ++report.unmatched;
       continue;
     }
@@ -74,7 +161,7 @@ RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
     item.relation_index = k;
     item.dt_s = std::abs(relation.timestamp_b_s - relation.timestamp_a_s);
     item.local = item.dt_s < config.local_max_dt_s;
-    const Pose2 estimated = Between(trajectory[a->second].pose, trajectory[b->second].pose);
+    const Pose2 estimated = Between(trajectory[*a].pose, trajectory[*b].pose);
     item.error = RelativePoseError(estimated, relation.T_a_b);
     t_all.push_back(item.error.translation_m);
     r_all.push_back(item.error.rotation_deg);
@@ -85,6 +172,7 @@ RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
   report.all = Summarize(t_all, r_all);
   report.local = Summarize(t_local, r_local);
   report.loop = Summarize(t_loop, r_loop);
+  report.refusal = RefusalOf(report, config);
   return report;
 }
 

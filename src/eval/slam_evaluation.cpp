@@ -88,8 +88,7 @@ void EvaluateRelationsOf(const SlamRun& run, const std::vector<Relation>& relati
     slam_timed.push_back({pose.timestamp_s, pose.T_world_robot});
     icp_timed.push_back({pose.timestamp_s, pose.T_world_robot_icp});
   }
-  RelationErrorConfig relation_config;
-  relation_config.local_max_dt_s = config.local_relation_max_dt_s;
+  const RelationErrorConfig relation_config = RelationConfigFrom(config);
   ev.relations = EvaluateRelations(slam_timed, relations, relation_config);
   ev.relations_icp = EvaluateRelations(icp_timed, relations, relation_config);
 }

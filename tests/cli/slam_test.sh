@@ -80,6 +80,28 @@ fails_with "--grid equal to --out" "--grid" "$keyplace" slam "$raw" --out "$work
 fails_with "grid config checked" "grid.free_thresh" "$keyplace" slam "$raw" \
   --grid "$work/bad.yaml" --set grid.free_thresh=0.9
 
+# Issue 17: no loops is "no loops" and null precisions, never 0.000; a relation file of another
+# log gives no relation error and says why.
+head -c 200000 "$raw" | sed '$d' >"$work/short.log"  # ~100 scans along a corridor, no revisit
+check "slam without loops" "$keyplace" slam "$work/short.log" \
+  --relations "$shared/data/intel.relations" --json "$work/short.json"
+cp "$work/out" "$work/short.out"
+check "no loops printed" grep -q "^loop precision     no loops$" "$work/short.out"
+check "relations of another log refused" grep -q \
+  "^relations: no relation error, no relation lies within the trajectory's time span" \
+  "$work/short.out"
+check "null precisions and relation errors" python3 -c "
+import json,sys
+j = json.load(open(sys.argv[1]))
+assert j['loops_detected'] == 0, j['loops_detected']
+for key in ['precision_overlap_10', 'precision_overlap_30', 'precision_overlap_30_common_area',
+            'precision_overlap_30_used', 'precision_overlap_30_matched_ransac']:
+    assert j[key] is None, (key, j[key])
+r = j['relations']
+assert r['translation_mean_m'] is None and r['all'] is None, r
+assert 'another log' in r['refusal'] and r['matched'] == 0, r
+" "$work/short.json"
+
 # Bad input names the file and the line; an existing output is left as it was.
 cp "$work/slam.json" "$work/slam.before.json"
 printf 'raw_index\tcorrected_index\n0\tzero\n' >"$work/bad-index.tsv"

@@ -1,8 +1,10 @@
 #include "keyplace/eval/relation_error.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -50,12 +52,13 @@ TEST(RelationErrorTest, KnownErrorsAndLocalLoopSplit) {
       {100.0, 102.0, Between(truth[0], truth[1]), 1},  // local (2 s), exact
       {102.0, 110.0, Between(truth[1], truth[2]), 2},  // loop (8 s)
       {110.0, 100.0, Between(truth[2], truth[0]), 3},  // loop, reversed
-      {100.0, 999.0, Pose2(), 4},                      // unmatched
+      {100.0, 999.0, Pose2(), 4},                      // after the last scan
   };
   const RelationErrorReport report = EvaluateRelations(trajectory, relations);
   EXPECT_EQ(report.relations, 4u);
   EXPECT_EQ(report.matched, 3u);
-  EXPECT_EQ(report.unmatched, 1u);
+  EXPECT_EQ(report.unmatched, 0u);
+  EXPECT_EQ(report.outside_span, 1u);
   EXPECT_EQ(report.local.count, 1u);
   EXPECT_EQ(report.loop.count, 2u);
   EXPECT_NEAR(report.local.translation_mean_m, 0.0, 1e-12);
@@ -81,16 +84,91 @@ TEST(RelationErrorTest, KnownErrorsAndLocalLoopSplit) {
   EXPECT_THROW(EvaluateRelations(trajectory, relations, bad), std::invalid_argument);
 }
 
-TEST(RelationErrorTest, ExactTimestampMatchingAndDuplicates) {
+TEST(RelationErrorTest, ToleranceNearestStampAndDuplicates) {
   const std::vector<TimedPose> trajectory = {{976052858.40413, Pose2(0, 0, 0)},
                                              {976052858.404131, Pose2(1, 0, 0)},
-                                             {976052858.40413, Pose2(5, 0, 0)}};  // duplicate
-  const std::vector<Relation> relations = {{976052858.404130, 976052858.404131, Pose2(1, 0, 0), 1},
-                                           {976052858.404132, 976052858.404131, Pose2(), 2}};
-  const RelationErrorReport report = EvaluateRelations(trajectory, relations);
-  EXPECT_EQ(report.duplicate_timestamps, 1u);
-  EXPECT_EQ(report.matched, 1u);                           // 1 us away is not a match
-  EXPECT_NEAR(report.all.translation_mean_m, 0.0, 1e-12);  // the first pose of a stamp is used
+                                             {976052858.40413, Pose2(5, 0, 0)},  // repeated stamp
+                                             {976052858.50413, Pose2(2, 0, 0)}};
+  const std::vector<Relation> relations = {
+      {976052858.404130, 976052858.404131, Pose2(1, 0, 0), 1},
+      {976052858.404132, 976052858.504180, Pose2(1, 0, 0), 2},  // 1 us and 50 us away
+      {976052858.404130, 976052858.454130, Pose2(), 3}};        // 50 ms from any stamp
+  RelationErrorConfig exact;
+  exact.stamp_tolerance_s = 0.0;
+  exact.min_matched_fraction = 0.0;
+  const RelationErrorReport exact_report = EvaluateRelations(trajectory, relations, exact);
+  EXPECT_EQ(exact_report.duplicate_timestamps, 1u);
+  EXPECT_EQ(exact_report.matched, 1u);  // only equal values match at tolerance 0
+  EXPECT_NEAR(exact_report.all.translation_mean_m, 0.0, 1e-12);  // the first pose of a stamp
+
+  RelationErrorConfig tolerant;  // 0.1 ms
+  tolerant.min_matched_fraction = 0.0;
+  const RelationErrorReport report = EvaluateRelations(trajectory, relations, tolerant);
+  EXPECT_EQ(report.matched, 2u);
+  EXPECT_EQ(report.unmatched, 1u);
+  EXPECT_EQ(report.outside_span, 0u);
+  // Relation 2: a -> the pose at ...404131 (1 us, nearer than ...40413), b -> the last pose.
+  EXPECT_NEAR(report.items[1].error.translation_m, 0.0, 1e-12);
+}
+
+// A log's stamps with 6 decimals, and relation files written with 6 and with 5 decimals.
+TEST(RelationErrorTest, FiveAndSixDecimalRelationStampsBothMatchTheLog) {
+  std::vector<TimedPose> trajectory;
+  for (int i = 0; i < 200; ++i) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.6f", 1234.567891 + 0.0266617 * i);
+    trajectory.push_back({std::stod(text), Pose2(0.1 * i, 0.02 * i, 0.01 * i)});
+  }
+  for (const char* format : {"%.6f", "%.5f"}) {
+    std::vector<Relation> relations;
+    for (int i = 0; i + 7 < 200; i += 3) {
+      char a[32];
+      char b[32];
+      std::snprintf(a, sizeof(a), format, trajectory[i].timestamp_s);
+      std::snprintf(b, sizeof(b), format, trajectory[i + 7].timestamp_s);
+      relations.push_back(
+          {std::stod(a), std::stod(b), Between(trajectory[i].pose, trajectory[i + 7].pose), 0});
+    }
+    const RelationErrorReport report = EvaluateRelations(trajectory, relations);
+    EXPECT_EQ(report.matched, relations.size()) << format;
+    EXPECT_TRUE(report.refusal.empty()) << format << ": " << report.refusal;
+    EXPECT_NEAR(report.all.translation_mean_m, 0.0, 1e-9) << format;
+  }
+}
+
+TEST(RelationErrorTest, TooFewMatchesAreRefusedRelationsOutsideTheLogAreNot) {
+  std::vector<TimedPose> trajectory;
+  trajectory.reserve(100);
+  for (int i = 0; i < 100; ++i) trajectory.push_back({100.0 + 0.2 * i, Pose2(0.1 * i, 0, 0)});
+  std::vector<Relation> relations;
+  for (int i = 0; i + 1 < 100; ++i) {               // 99 inside the span, 5 of them on the stamps
+    const double shift = i % 20 == 0 ? 0.0 : 0.05;  // 50 ms off: another log's scans
+    relations.push_back({100.0 + 0.2 * i + shift, 100.2 + 0.2 * i + shift, Pose2(0.1, 0, 0), 0});
+  }
+  const RelationErrorReport refused = EvaluateRelations(trajectory, relations);
+  EXPECT_EQ(refused.matched, 5u);
+  EXPECT_EQ(refused.unmatched, 93u);
+  EXPECT_EQ(refused.outside_span, 1u);
+  EXPECT_NE(refused.refusal.find("only 5 of the 98 relations"), std::string::npos)
+      << refused.refusal;
+  EXPECT_NE(refused.refusal.find("within 0.1 ms, below 95 %"), std::string::npos)
+      << refused.refusal;
+
+  // A relation file of the whole log against a slice of it: the relations beyond the slice are
+  // not held against it.
+  std::vector<Relation> whole;
+  for (int i = 0; i + 1 < 100; ++i) {
+    whole.push_back({100.0 + 0.2 * i, 100.2 + 0.2 * i, Pose2(0.1, 0, 0), 0});
+  }
+  whole.push_back({90.0, 100.0, Pose2(), 0});
+  whole.push_back({119.8, 130.0, Pose2(), 0});
+  const RelationErrorReport slice = EvaluateRelations(trajectory, whole);
+  EXPECT_EQ(slice.matched, 99u);
+  EXPECT_EQ(slice.outside_span, 2u);
+  EXPECT_TRUE(slice.refusal.empty()) << slice.refusal;
+  EXPECT_NE(EvaluateRelations(trajectory, {}).refusal.find("no relation"), std::string::npos);
+  EXPECT_NE(EvaluateRelations(trajectory, {{5.0, 6.0, Pose2(), 0}}).refusal.find("another log"),
+            std::string::npos);
 }
 
 TEST(RelationErrorTest, DriftAgainstCorrectedPoses) {

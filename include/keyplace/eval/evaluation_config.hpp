@@ -7,6 +7,13 @@ namespace keyplace {
 struct EvaluationConfig {
   // Relations with |t_b - t_a| below this are local, the others loop (Kümmerle et al.).
   double local_relation_max_dt_s = 5.0;
+  // A relation stamp matches the scan with the nearest stamp within this (s): 0.1 ms, far below
+  // a scan period (13-200 ms in the data sets) and far above the rounding of stamps written with
+  // 5 or 6 decimals.
+  double relation_stamp_tolerance_s = 1e-4;
+  // No relation error is printed when fewer than this fraction of the relations inside the log's
+  // time span matched (the reason is printed instead; JSON: null errors and "refusal").
+  double min_matched_relations = 0.95;
   // A loop of `keyplace slam` is checked against ground truth when its submap origins lie at most
   // this many scans (processing order) from a scan with a corrected pose; FR101 has one corrected
   // scan per 16 raw ones.

@@ -3,9 +3,11 @@
 // (SLAM-optimised) poses.
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/io/relations.hpp"
 
 namespace keyplace {
@@ -42,7 +44,17 @@ PoseError RelativePoseError(const Pose2& estimated_T_a_b, const Pose2& true_T_a_
 struct RelationErrorConfig {
   // Relations with |t_b - t_a| below this are "local", the others "loop" (s).
   double local_max_dt_s = 5.0;
+  // A relation stamp matches the trajectory pose with the nearest stamp when they differ by at
+  // most this (s): relation files written with 5 decimals (10 us) must match logs with 6.
+  double stamp_tolerance_s = 1e-4;
+  // No error is given (RelationErrorReport::refusal) when fewer than this fraction of the
+  // relations inside the trajectory's time span matched: the file belongs to another log, or
+  // its stamps were written differently.
+  double min_matched_fraction = 0.95;
 };
+
+/// The relation settings of the evaluation section (evaluation.local_relation_max_dt_s, ...).
+RelationErrorConfig RelationConfigFrom(const EvaluationConfig& config);
 
 struct RelationErrorItem {
   std::size_t relation_index = 0;  // into the relation vector
@@ -53,10 +65,16 @@ struct RelationErrorItem {
 
 struct RelationErrorReport {
   std::size_t relations = 0;  // relations given
-  std::size_t matched = 0;    // both stamps found in the trajectory
-  std::size_t unmatched = 0;  // at least one stamp missing (not evaluated)
-  // Trajectory poses whose timestamp key repeats an earlier one (the first one is used).
+  // Relations with a stamp outside the trajectory's first..last stamp (e.g. a slice of the log):
+  // not evaluated, and not held against the matched fraction.
+  std::size_t outside_span = 0;
+  std::size_t matched = 0;    // both stamps matched a trajectory stamp
+  std::size_t unmatched = 0;  // inside the span, at least one stamp unmatched (not evaluated)
+  // Trajectory poses whose stamp equals an earlier one (the first one is used).
   std::size_t duplicate_timestamps = 0;
+  // Why the errors below must not be reported (empty: they may): too few relations matched.
+  // The statistics are still computed over the matched ones.
+  std::string refusal;
   ErrorStats all;
   ErrorStats local;
   ErrorStats loop;
@@ -64,9 +82,9 @@ struct RelationErrorReport {
 };
 
 /// Kümmerle et al. (2009): for every relation (a, b) with true relative pose delta*, the
-/// estimated delta = T_a^-1 T_b is compared with delta*. Timestamps are matched exactly by
-/// TimestampKey (integer microseconds). Throws std::invalid_argument for a negative
-/// local_max_dt_s.
+/// estimated delta = T_a^-1 T_b is compared with delta*. Each relation stamp is matched to the
+/// trajectory pose with the nearest stamp, within config.stamp_tolerance_s (ties and repeated
+/// stamps: the earlier pose). Throws std::invalid_argument naming an invalid config field.
 RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
                                       const std::vector<Relation>& relations,
                                       const RelationErrorConfig& config = {});
