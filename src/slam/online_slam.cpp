@@ -72,6 +72,16 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
     points.push_back(scan.T_robot_laser * scan.Endpoint(i));
   }
   pending_points_.push_back(std::move(points));
+  ScanKeypoints scan_keypoints;
+  if (config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+    scan_keypoints.positions_robot.reserve(keypoints.size());
+    scan_keypoints.descriptors.reserve(keypoints.size());
+    for (const Keypoint& keypoint : keypoints) {
+      scan_keypoints.positions_robot.push_back(scan.T_robot_laser * keypoint.position_m);
+      scan_keypoints.descriptors.push_back(keypoint.descriptor);
+    }
+  }
+  pending_keypoints_.push_back(std::move(scan_keypoints));
   ++stats_.scans;
   map_.source_scans = stats_.scans;
   map_.source_keypoints += keypoints.size();
@@ -131,12 +141,23 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
   icp_origins_.push_back(icp_origin);
   icp_submap_poses_.push_back(submap.poses);
   origin_path_m_.push_back(origin_path);
+  PlaceQuery query;
   {
     std::vector<Pose2> T_submap_robot;
     T_submap_robot.reserve(submap.poses.size());
     for (const Pose2& p : submap.poses) T_submap_robot.push_back(Between(icp_origin, p));
     clouds_.push_back(BuildSubmapCloud(pending_points_, T_submap_robot, config_.loop_refinement));
     pending_points_.clear();
+    // Every keypoint of every scan in the submap frame, latest scans first (as MakeSubmapQuery),
+    // so that merging nearby keypoints keeps the latest.
+    for (std::size_t k = pending_keypoints_.size(); k-- > 0;) {
+      const ScanKeypoints& scan = pending_keypoints_[k];
+      for (std::size_t i = 0; i < scan.positions_robot.size(); ++i) {
+        query.all_positions.push_back(T_submap_robot.at(k) * scan.positions_robot[i]);
+        query.all_descriptors.push_back(scan.descriptors[i]);
+      }
+    }
+    pending_keypoints_.clear();
   }
   // The submap's poses follow its (possibly corrected) node.
   const Pose2 node = graph_.node(id);
@@ -150,7 +171,6 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
     place.positions.push_back(keypoint.position_m);
     place.descriptors.push_back(keypoint.descriptor);
   }
-  PlaceQuery query;
   query.positions = place.positions;
   query.descriptors = place.descriptors;
   query.T_first_evaluated = Between(submap.poses.front(), submap.poses.back());

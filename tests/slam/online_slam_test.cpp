@@ -98,6 +98,30 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   }
 }
 
+// Issue 17: the loop detector queries with the keypoints of all the submap's scans, as
+// `keyplace localize` does. With gamma_min 1 for stable-keypoint queries no loop can pass the
+// stable query's gamma check; the all-scan query is held to min_gamma_all_scans instead.
+TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
+  const SimulatedRun run = Simulate(1.4);
+  const FlirtExtractor extractor;
+  std::vector<std::vector<Keypoint>> keypoints;
+  keypoints.reserve(run.scans.size());
+  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  auto loops_found = [&](PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
+    SlamConfig config = SimulationConfig();
+    config.place.query_keypoints = query_keypoints;
+    config.place.min_gamma = 1.0;
+    OnlineSlam slam(config);
+    for (std::size_t i = 0; i < run.scans.size(); ++i) {
+      slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints[i]);
+    }
+    slam.Finish();
+    return slam.loops().size();
+  };
+  EXPECT_EQ(loops_found(PlaceRecognitionConfig::QueryKeypoints::kStable), 0U);
+  EXPECT_GE(loops_found(PlaceRecognitionConfig::QueryKeypoints::kAllScans), 1U);
+}
+
 TEST(OnlineSlam, RejectsInvalidConfig) {
   SlamConfig config;
   config.optimize_every_loops = 0;

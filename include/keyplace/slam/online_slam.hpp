@@ -198,6 +198,13 @@ class OnlineSlam {
   std::vector<OccupancySummary> observed_areas_;  // one per completed submap
   // Endpoints (robot frame, range-filtered) of the scans of the submap in progress.
   std::vector<std::vector<Eigen::Vector2d>> pending_points_;
+  // The keypoints (robot frame) of the scans of the submap in progress: the loop query uses all
+  // of them, as `keyplace localize` does, when place.query_keypoints is all_scans (issue 17).
+  struct ScanKeypoints {
+    std::vector<Eigen::Vector2d> positions_robot;
+    std::vector<BetaGridDescriptor> descriptors;
+  };
+  std::vector<ScanKeypoints> pending_keypoints_;
   std::vector<Place> places_;  // one per completed submap (place frame = submap frame)
   std::unique_ptr<PlaceRecognizer> recognizer_;  // the eligible prefix of places_
   std::vector<LoopClosure> loops_;
