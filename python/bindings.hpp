@@ -2,7 +2,9 @@
 // Shared pieces of the keyplace Python module: the Bind* function of each binding file and the
 // conversions between the library's types and numpy arrays (docs/PYTHON.md).
 
+#include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
