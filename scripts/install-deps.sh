@@ -14,8 +14,9 @@ packages=(
   # ROS 1 bags: Debian's rosbag storage library, the message headers, the chunk codecs
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libgeometry-msgs-dev
   libroslz4-dev libbz2-dev
-  # the CLI tests read JSON with python3
-  python3
+  # the CLI tests read JSON with python3; the Python module's tests and example (Debian's
+  # /usr/bin/python3) use numpy and matplotlib
+  python3 python3-numpy python3-matplotlib
   # tests, benchmarks, style
   libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
   # make fuzz: clang and its libFuzzer and sanitizer runtimes

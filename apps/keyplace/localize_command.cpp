@@ -19,6 +19,7 @@
 #include "io/atomic_file.hpp"
 #include "keyplace/eval/distractor_map.hpp"
 #include "keyplace/eval/global_localization.hpp"
+#include "keyplace/eval/map_localization.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "localize_output.hpp"
 #include "paper_tables.hpp"
@@ -117,25 +118,17 @@ void RunLocalize(const LocalizeOptions& options) {
   const GroundTruth& truth = query.truth;
   const std::string map_log_path =
       options.query.truth_path.empty() ? options.query.log_path : options.query.truth_path;
-  const std::vector<int> starts = QueryStarts(truth, options.n_pos);
-  if (starts.size() < static_cast<std::size_t>(options.n_pos)) {
-    fmt::print(stderr,
-               "keyplace: note: --n-pos {} capped to the {} query scans with a truth pose\n",
-               options.n_pos, starts.size());
-  }
-
-  std::vector<Place> places;
-  std::vector<LocalizationQuery> queries;
-  std::vector<Submap> map_scans;  // where a query is revisitable
+  std::vector<LocalizationRecord> records;
+  std::size_t places = 0;
+  std::size_t requested_starts = 0;
   std::string map_description;
   bool truth_is_map_log = true;  // the TIP-FLIRT places are scans of the truth log
+  double recognition_seconds = 0.0;
   if (!baseline) {
     GlobalMap map = LoadMap(options.map_path);
     truth_is_map_log = TruthIsMapLog(map, truth);
     WarnAboutMapSource(options.map_path, map, map_log_path, truth_is_map_log);
     if (!truth_is_map_log) {
-      // Scan indices of two files name different scans: no map place is a self-match.
-      rule = SelfMatchRule::kNone;
       fmt::print(
           "self-match         none: the query log is another recording than the map's {} (no "
           "self-match exclusion)\n",
@@ -153,13 +146,20 @@ void RunLocalize(const LocalizeOptions& options) {
       map_description += fmt::format(" among distractors: {} submaps, {} keypoints",
                                      map.submaps.size(), map.KeypointCount());
     }
-    places = PlacesFromMap(map);
-    map_scans = std::move(map.submaps);
-    Progress progress("query submaps", starts.size());
-    queries = BuildSubmapQueries(inputs, truth, map.config, starts, config.place.query_keypoints,
-                                 [&](std::size_t done, std::size_t) { progress.Update(done); });
-    progress.Finish();
+    MapLocalizationOptions localization;
+    localization.n_pos = options.n_pos;
+    localization.self_match = rule;
+    localization.rank_by = rank_by;
+    MapLocalization result = LocalizeLogAgainstMap(
+        inputs, truth, map, config.place, config.evaluation, localization, StageProgressBar());
+    requested_starts = result.starts.size();
+    rule = result.self_match;
+    places = result.places;
+    records = std::move(result.records);
+    recognition_seconds = result.seconds_recognition;
   } else {
+    const std::vector<int> starts = QueryStarts(truth, options.n_pos);
+    requested_starts = starts.size();
     LogInputOptions map_options = query.input_options;
     map_options.poses = PoseSource::kCorrected;
     // --scans cuts the query log; the places of a --truth log are all of its scans.
@@ -168,19 +168,22 @@ void RunLocalize(const LocalizeOptions& options) {
     const LogInputs map_log = options.query.truth_path.empty()
                                   ? inputs
                                   : PrepareLogInputs(options.query.truth_path, map_options);
-    places = ScanPlaces(map_log);
-    map_scans = ScanPlacesAsSubmaps(places);
-    map_description =
-        fmt::format("TIP-FLIRT: {} scans of {} as places", places.size(), map_log_path);
-    queries = BuildScanQueries(inputs, truth, starts);
+    std::vector<Place> scan_places = ScanPlaces(map_log);
+    const std::vector<Submap> map_scans = ScanPlacesAsSubmaps(scan_places);
+    places = scan_places.size();
+    map_description = fmt::format("TIP-FLIRT: {} scans of {} as places", places, map_log_path);
+    const std::vector<LocalizationQuery> queries = BuildScanQueries(inputs, truth, starts);
+    const auto recognition_start = std::chrono::steady_clock::now();
+    records = EvaluateLocalizationQueries(queries, std::move(scan_places), map_scans, config.place,
+                                          rule, config.evaluation, StageProgressBar());
+    recognition_seconds = SecondsSince(recognition_start);
   }
-  const double preparation_seconds = SecondsSince(start);
-  const PlaceRecognizer recognizer(std::move(places), config.place);
-  Progress progress("localize", queries.size());
-  std::vector<LocalizationRecord> records = EvaluateQueries(
-      queries, recognizer, rule, [&](std::size_t done, std::size_t) { progress.Update(done); });
-  progress.Finish();
-  MarkRevisitable(queries, map_scans, rule, config.evaluation, records);
+  if (requested_starts < static_cast<std::size_t>(options.n_pos)) {
+    fmt::print(stderr,
+               "keyplace: note: --n-pos {} capped to the {} query scans with a truth pose\n",
+               options.n_pos, requested_starts);
+  }
+  const double preparation_seconds = SecondsSince(start) - recognition_seconds;
 
   LocalizeReport report;
   report.log_path = options.query.log_path;
@@ -211,7 +214,7 @@ void RunLocalize(const LocalizeOptions& options) {
     json["map"] = baseline ? "" : options.map_path;
     json["baseline"] = options.baseline;
     json["truth"] = options.query.truth_path;
-    json["places"] = recognizer.places().size();
+    json["places"] = places;
     json["config"] = ConfigJson(config);
     json["seconds_total"] = SecondsSince(start);
     WriteJson(options.json_path, json);

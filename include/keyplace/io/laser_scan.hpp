@@ -38,4 +38,12 @@ struct LaserScan {
   std::vector<Eigen::Vector2d> ValidEndpoints() const;
 };
 
+/// A scan from its beams, for callers that have them from elsewhere (a driver, Python): a beam is
+/// valid when its range is finite, > 0 and < max_range_m, as the log readers decide. Throws
+/// std::invalid_argument when ranges and angles differ in size, there are more than
+/// kMaxScanBeams beams, an angle is not finite or max_range_m is not positive.
+LaserScan MakeLaserScan(std::vector<double> ranges_m, std::vector<double> angles_rad,
+                        double max_range_m, double timestamp_s = 0.0,
+                        const Pose2& T_robot_laser = Pose2());
+
 }  // namespace keyplace

@@ -1,0 +1,71 @@
+#pragma once
+// Shared pieces of the keyplace Python module: the Bind* function of each binding file and the
+// conversions between the library's types and numpy arrays (docs/PYTHON.md).
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <Eigen/Core>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/config/config.hpp"
+#include "keyplace/features/descriptor.hpp"
+#include "keyplace/io/laser_scan.hpp"
+
+namespace keyplace::python {
+
+namespace py = pybind11;
+
+void BindConfig(py::module_& module);
+void BindIo(py::module_& module);
+void BindFeatures(py::module_& module);
+void BindMapping(py::module_& module);
+void BindLocalization(py::module_& module);
+void BindEvaluation(py::module_& module);
+
+/// The configuration of keyplace.Config: the library's Config and the preset it started from
+/// (the preset decides defaults such as localize's rank_by, as in the CLI).
+struct PyConfig {
+  Config config;
+  std::string preset = "default";
+};
+
+/// The configuration a function was given: `config` (None, a preset name or a keyplace.Config),
+/// then `overrides` (None or a dict of "section.key" -> value, like --set).
+PyConfig ResolveConfig(const py::object& config, const py::object& overrides);
+
+/// [x, y, theta] (m, m, rad).
+py::array_t<double> PoseArray(const Pose2& pose);
+/// None for an empty optional, else PoseArray.
+py::object OptionalPoseArray(const std::optional<Pose2>& pose);
+/// N x 3 array of [x, y, theta] rows.
+py::array_t<double> PosesArray(const std::vector<Pose2>& poses);
+/// A pose from any sequence of three numbers; throws ValueError naming `what` otherwise.
+Pose2 ToPose(const py::handle& value, const std::string& what);
+/// N x 2 array of points.
+py::array_t<double> PointsArray(const std::vector<Eigen::Vector2d>& points);
+/// N x kBetaGridBins float32 array.
+py::array_t<float> DescriptorsArray(const std::vector<BetaGridDescriptor>& descriptors);
+
+/// 1-D array copy of a vector.
+template <typename T>
+py::array_t<T> VectorArray(const std::vector<T>& values) {
+  py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
+  std::copy(values.begin(), values.end(), array.mutable_data());
+  return array;
+}
+/// 1-D array of flags (numpy bool).
+py::array_t<bool> FlagsArray(const std::vector<std::uint8_t>& flags);
+
+/// The scan argument of extract_keypoints and add_scan: a keyplace.Scan, or ranges (1-D array,
+/// m) with their bearings `angles_rad` (laser frame), `max_range_m` and the laser mounting
+/// `laser_pose` (T_robot_laser; None = identity).
+LaserScan ToScan(const py::object& scan, const py::object& angles_rad, double max_range_m,
+                 const py::object& laser_pose);
+
+}  // namespace keyplace::python

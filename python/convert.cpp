@@ -1,0 +1,129 @@
+// Conversions between the library's types and numpy arrays, and configuration from Python.
+
+#include <algorithm>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "keyplace/io/carmen_log.hpp"
+
+namespace keyplace::python {
+namespace {
+
+// A Python value as the text SetConfigValue parses: bools as true/false, floats by repr (the
+// shortest text that reads back the same double), everything else by str.
+std::string ConfigText(const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+  return py::str(value).cast<std::string>();
+}
+
+std::vector<double> ToDoubles(const py::object& values, const std::string& what) {
+  const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+  if (!array || array.ndim() != 1) {
+    throw py::value_error(what + " must be a 1-D array of numbers");
+  }
+  return {array.data(), array.data() + array.size()};
+}
+
+}  // namespace
+
+PyConfig ResolveConfig(const py::object& config, const py::object& overrides) {
+  PyConfig resolved;
+  if (py::isinstance<PyConfig>(config)) {
+    resolved = config.cast<PyConfig>();
+  } else if (py::isinstance<py::str>(config)) {
+    resolved.preset = config.cast<std::string>();
+    resolved.config = PresetConfig(resolved.preset);
+  } else if (!config.is_none()) {
+    throw py::type_error("config must be None, a preset name or a keyplace.Config");
+  }
+  if (overrides.is_none()) return resolved;
+  if (!py::isinstance<py::dict>(overrides)) {
+    throw py::type_error("overrides must be a dict of 'section.key' -> value");
+  }
+  for (const auto& [key, value] : overrides.cast<py::dict>()) {
+    SetConfigValue(py::str(key).cast<std::string>(), ConfigText(value), resolved.config);
+  }
+  return resolved;
+}
+
+py::array_t<double> PoseArray(const Pose2& pose) {
+  py::array_t<double> array(3);
+  double* data = array.mutable_data();
+  data[0] = pose.x;
+  data[1] = pose.y;
+  data[2] = pose.theta;
+  return array;
+}
+
+py::object OptionalPoseArray(const std::optional<Pose2>& pose) {
+  if (!pose) return py::none();
+  return PoseArray(*pose);
+}
+
+py::array_t<double> PosesArray(const std::vector<Pose2>& poses) {
+  py::array_t<double> array({static_cast<py::ssize_t>(poses.size()), py::ssize_t{3}});
+  auto view = array.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < view.shape(0); ++i) {
+    const Pose2& pose = poses[static_cast<std::size_t>(i)];
+    view(i, 0) = pose.x;
+    view(i, 1) = pose.y;
+    view(i, 2) = pose.theta;
+  }
+  return array;
+}
+
+Pose2 ToPose(const py::handle& value, const std::string& what) {
+  const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!array || array.ndim() != 1 || array.size() != 3) {
+    throw py::value_error(what + " must be three numbers [x_m, y_m, theta_rad]");
+  }
+  return {array.at(0), array.at(1), array.at(2)};
+}
+
+py::array_t<double> PointsArray(const std::vector<Eigen::Vector2d>& points) {
+  py::array_t<double> array({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
+  auto view = array.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < view.shape(0); ++i) {
+    view(i, 0) = points[static_cast<std::size_t>(i)].x();
+    view(i, 1) = points[static_cast<std::size_t>(i)].y();
+  }
+  return array;
+}
+
+py::array_t<float> DescriptorsArray(const std::vector<BetaGridDescriptor>& descriptors) {
+  py::array_t<float> array(
+      {static_cast<py::ssize_t>(descriptors.size()), static_cast<py::ssize_t>(kBetaGridBins)});
+  float* data = array.mutable_data();
+  for (const BetaGridDescriptor& descriptor : descriptors) {
+    data = std::copy(descriptor.begin(), descriptor.end(), data);
+  }
+  return array;
+}
+
+py::array_t<bool> FlagsArray(const std::vector<std::uint8_t>& flags) {
+  py::array_t<bool> array(static_cast<py::ssize_t>(flags.size()));
+  std::transform(flags.begin(), flags.end(), array.mutable_data(),
+                 [](std::uint8_t flag) { return flag != 0; });
+  return array;
+}
+
+LaserScan ToScan(const py::object& scan, const py::object& angles_rad, double max_range_m,
+                 const py::object& laser_pose) {
+  if (py::isinstance<LogScan>(scan)) return scan.cast<const LogScan&>();
+  if (angles_rad.is_none()) {
+    throw py::value_error(
+        "ranges need their bearings: pass angles_rad (laser frame, rad; e.g. "
+        "numpy.linspace(-fov / 2, fov / 2, len(ranges))) or a keyplace.Scan");
+  }
+  const Pose2 T_robot_laser = laser_pose.is_none() ? Pose2() : ToPose(laser_pose, "laser_pose");
+  return MakeLaserScan(ToDoubles(scan, "ranges"), ToDoubles(angles_rad, "angles_rad"), max_range_m,
+                       0.0, T_robot_laser);
+}
+
+}  // namespace keyplace::python
