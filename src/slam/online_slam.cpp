@@ -73,7 +73,8 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
   }
   pending_points_.push_back(std::move(points));
   ScanKeypoints scan_keypoints;
-  if (config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+  if (config_.all_scan_loop_queries &&
+      config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
     scan_keypoints.positions_robot.reserve(keypoints.size());
     scan_keypoints.descriptors.reserve(keypoints.size());
     for (const Keypoint& keypoint : keypoints) {

@@ -98,9 +98,10 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   }
 }
 
-// Issue 17: the loop detector queries with the keypoints of all the submap's scans, as
-// `keyplace localize` does. With gamma_min 1 for stable-keypoint queries no loop can pass the
-// stable query's gamma check; the all-scan query is held to min_gamma_all_scans instead.
+// Issue 17: with slam.all_scan_loop_queries the loop detector queries with the keypoints of all
+// the submap's scans, as `keyplace localize` does. With gamma_min 1 for stable-keypoint queries no
+// loop can pass the stable query's gamma check; the all-scan query is held to min_gamma_all_scans
+// instead.
 TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   const SimulatedRun run = Simulate(1.4);
   const FlirtExtractor extractor;
@@ -109,6 +110,7 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
   auto loops_found = [&](PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
     SlamConfig config = SimulationConfig();
+    config.all_scan_loop_queries = true;
     config.place.query_keypoints = query_keypoints;
     config.place.min_gamma = 1.0;
     OnlineSlam slam(config);

@@ -44,6 +44,11 @@ struct SlamConfig {
   // are neighbours that overlap by construction, not loops.
   int exclude_recent_submaps = 10;
   double exclude_recent_path_m = 10.0;
+  // Query each completed submap with the keypoints of all its scans (as `keyplace localize`
+  // does; needs place.query_keypoints = all_scans, then place.min_gamma_all_scans applies) instead
+  // of its stable keypoints. Off: on FR079_r it detected 221 loops of which 41 wrong against
+  // ground truth at the localize thresholds (docs/SLAM.md, "All-scan loop queries").
+  bool all_scan_loop_queries = false;
 
   // --- loop acceptance: a loop is a PlaceMatch with `found` (verified, not ambiguous); it becomes
   // a graph edge when it also passes the gate: the measured T_ref_cur agrees with the current
