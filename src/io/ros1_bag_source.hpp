@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "keyplace/io/carmen_log.hpp"
+#include "io/bag_log.hpp"
 
 namespace keyplace {
 
@@ -26,13 +26,6 @@ struct RawBagMessage {
 };
 
 using RawMessageVisitor = std::function<void(const RawBagMessage&)>;
-
-/// What a walk over a bag found besides the messages.
-struct BagSummary {
-  std::vector<LogTopic> topics;       // every topic, with its type and message count
-  std::vector<std::string> warnings;  // what was dropped, naming the bag
-  std::size_t messages = 0;           // in the bag (the complete chunks for a walked one)
-};
 
 /// Thrown by VisitIndexedBag when rosbag cannot open the bag (no or damaged index, cut off).
 struct BagIndexError : std::runtime_error {
