@@ -32,9 +32,14 @@ struct BagIndexError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The messages on `topics` in time order, through rosbag. Throws BagIndexError when the bag
-/// cannot be opened, std::invalid_argument naming the bag and topic when a chunk cannot be read
-/// (e.g. an unknown compression).
+/// Throws BagIndexError unless every record of the bag lies within the file and every compressed
+/// chunk claims a plausible uncompressed size (chunk_limits.hpp): rosbag trusts these lengths and
+/// allocates what they say (a hostile 4-byte field made it ask for 1.1 GB).
+void CheckBagRecords(const std::string& path);
+
+/// The messages on `topics` in time order, through rosbag (after CheckBagRecords). Throws
+/// BagIndexError when the bag cannot be opened, std::invalid_argument naming the bag and topic when
+/// a chunk cannot be read (e.g. an unknown compression).
 BagSummary VisitIndexedBag(const std::string& path, const std::set<std::string>& topics,
                            const RawMessageVisitor& visitor);
 

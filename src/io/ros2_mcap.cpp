@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "io/chunk_limits.hpp"
 #include "io/ros2_storage.hpp"
 
 namespace keyplace {
@@ -29,11 +30,6 @@ constexpr std::uint8_t kOpMessage = 0x05;
 constexpr std::uint8_t kOpChunk = 0x06;
 constexpr std::uint8_t kOpDataEnd = 0x0F;
 constexpr std::size_t kRecordHeaderBytes = 9;
-// rosbag2 writes chunks of 768 KiB; a chunk claiming more than this is damage, not data.
-constexpr std::uint64_t kMaxChunkBytes = 256ULL << 20U;
-// Lidar messages do not compress 1000-fold; a larger claim from few bytes is damage.
-constexpr std::uint64_t kMaxCompressionRatio = 1024;
-constexpr std::uint64_t kMinChunkLimitBytes = 16ULL << 20U;
 
 // Reads the fields of one record's content; false once a field runs past its end.
 class Cursor {
@@ -157,12 +153,11 @@ class McapWalker {
                          " bytes that claims " + std::to_string(uncompressed_bytes));
       }
     } else {
-      const std::uint64_t limit = std::min(
-          kMaxChunkBytes, std::max(kMinChunkLimitBytes, kMaxCompressionRatio * records_bytes));
-      if (uncompressed_bytes > limit) {
+      if (!PlausibleChunkBytes(uncompressed_bytes, records_bytes)) {
         Fail(offset, "a chunk claiming " + std::to_string(uncompressed_bytes) +
                          " bytes uncompressed from " + std::to_string(records_bytes));
       }
+      CheckFrameSize(compression, records, records_bytes, uncompressed_bytes, offset);
       chunk_.resize(uncompressed_bytes);
       Decompress(compression, records, records_bytes, offset);
       plain = chunk_.data();
@@ -174,6 +169,21 @@ class McapWalker {
     }
     WalkRecords(plain, uncompressed_bytes, offset);
     ++chunks_;
+  }
+
+  // A zstd frame that says its size must say the chunk's: checked before the buffer is allocated.
+  void CheckFrameSize(const std::string& compression, const std::uint8_t* in,
+                      std::uint64_t in_bytes, std::uint64_t uncompressed_bytes,
+                      std::uint64_t offset) const {
+    if (compression != "zstd") return;
+    const unsigned long long frame_bytes = ZSTD_getFrameContentSize(in, in_bytes);
+    if (frame_bytes == ZSTD_CONTENTSIZE_ERROR) {
+      Fail(offset, "a zstd chunk that does not decompress (no zstd frame)");
+    }
+    if (frame_bytes != ZSTD_CONTENTSIZE_UNKNOWN && frame_bytes != uncompressed_bytes) {
+      Fail(offset, "a zstd chunk of " + std::to_string(frame_bytes) + " bytes that claims " +
+                       std::to_string(uncompressed_bytes));
+    }
   }
 
   void Decompress(const std::string& compression, const std::uint8_t* in, std::uint64_t in_bytes,
@@ -191,18 +201,21 @@ class McapWalker {
     if (!ok) Fail(offset, "a " + compression + " chunk that does not decompress");
   }
 
-  // The LZ4 frame format, as MCAP's "lz4" chunks hold it.
+  // The LZ4 frame format, as MCAP's "lz4" chunks hold it. One context for all chunks: it keeps
+  // its block buffers (up to 4 MiB each), which a context per chunk would allocate again.
   bool DecompressLz4(const std::uint8_t* in, std::size_t in_bytes) {
-    LZ4F_dctx* raw = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION)) != 0) return false;
-    const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> context(
-        raw, &LZ4F_freeDecompressionContext);
+    if (!lz4_) {
+      LZ4F_dctx* raw = nullptr;
+      if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION)) != 0) return false;
+      lz4_.reset(raw);
+    }
+    LZ4F_resetDecompressionContext(lz4_.get());
     std::size_t out_at = 0;
     std::size_t in_at = 0;
     while (true) {
       std::size_t out_bytes = chunk_.size() - out_at;
       std::size_t in_left = in_bytes - in_at;
-      const std::size_t hint = LZ4F_decompress(context.get(), chunk_.data() + out_at, &out_bytes,
+      const std::size_t hint = LZ4F_decompress(lz4_.get(), chunk_.data() + out_at, &out_bytes,
                                                in + in_at, &in_left, nullptr);
       if (LZ4F_isError(hint) != 0) return false;
       out_at += out_bytes;
@@ -211,6 +224,10 @@ class McapWalker {
       if (in_at == in_bytes || (out_bytes == 0 && in_left == 0)) return false;
     }
   }
+
+  struct FreeLz4Context {
+    void operator()(LZ4F_dctx* context) const { LZ4F_freeDecompressionContext(context); }
+  };
 
   void WalkRecords(const std::uint8_t* data, std::uint64_t size, std::uint64_t chunk_offset) {
     Cursor cursor(data, size);
@@ -303,6 +320,7 @@ class McapWalker {
   std::ifstream file_;
   std::uint64_t file_bytes_ = 0;
   std::vector<std::uint8_t> chunk_;
+  std::unique_ptr<LZ4F_dctx, FreeLz4Context> lz4_;
   std::map<std::uint16_t, std::string> schema_names_;
   // Stable addresses: StorageMessage refers to its topic.
   std::map<std::uint16_t, std::unique_ptr<StorageTopic>> channels_;
