@@ -14,6 +14,8 @@ packages=(
   # ROS 1 bags: Debian's rosbag storage library, the message headers, the chunk codecs
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libgeometry-msgs-dev
   libroslz4-dev libbz2-dev
+  # ROS 2 bags: MCAP chunk codecs (LZ4 frames, zstd); sqlite3 and yaml-cpp are above
+  liblz4-dev libzstd-dev
   # the CLI tests read JSON with python3; the Python module's tests and example (Debian's
   # /usr/bin/python3) use numpy and matplotlib
   python3 python3-numpy python3-matplotlib

@@ -122,9 +122,11 @@ void RegisterFeaturesCommand(CLI::App& app) {
       "features",
       "Extract FLIRT keypoints (curvature detector + beta-grid descriptor, FLIRTLib defaults; "
       "--set features.KEY=VALUE changes them) from the scans of a log and print statistics.");
-  command->add_option("input", options->input, "CARMEN log (.log, .log.gz) or ROS 1 bag")
+  command
+      ->add_option("input", options->input,
+                   "CARMEN log (.log, .log.gz), ROS 1 bag or ROS 2 bag (directory, .mcap, .db3)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command
       ->add_option("--scans", options->scans,
                    "Half-open range A:B of 0-based scan indices (e.g. 0:50, :100, 200:)")

@@ -16,6 +16,7 @@
 #include "config_options.hpp"
 #include "io/sqlite_magic.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/io/ros2_bag.hpp"
 #include "keyplace/io/timestamps.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/store/map_file.hpp"
@@ -241,7 +242,8 @@ void RunInfo(const InfoOptions& options) {
     return;
   }
   nlohmann::json json;
-  if (IsSqliteFile(options.input)) {
+  // A rosbag2 sqlite3 file (*.db3) is an SQLite file too, but a log.
+  if (IsSqliteFile(options.input) && !IsRos2Bag(options.input)) {
     json = DescribeMap(options.input, LoadMap(options.input));
     PrintMap(json);
   } else {
@@ -263,14 +265,16 @@ void RegisterInfoCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "info",
       "Describe a CARMEN log (scans, beams, field of view, duration, path length, line types, "
-      "invalid beams), a ROS 1 bag (the same, and its topics, types and message counts) or a map "
-      "file (submaps, keypoints, the configuration that made it); "
+      "invalid beams), a ROS 1 or ROS 2 bag (the same, and its topics, types and message counts) "
+      "or a map file (submaps, keypoints, the configuration that made it); "
       "--check verifies a map file.");
   command
-      ->add_option("input", options->input,
-                   "CARMEN log (.log, .log.gz), ROS 1 bag or map file (.kpm)")
+      ->add_option(
+          "input", options->input,
+          "CARMEN log (.log, .log.gz), ROS 1 bag, ROS 2 bag (directory, .mcap, .db3) or map "
+          "file (.kpm)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command->add_option("--json", options->json_path, "Also write the figures as JSON to FILE");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
   AddConfigOptions(command, options->config);  // the input section: how a bag is read

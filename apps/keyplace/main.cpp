@@ -14,7 +14,8 @@ int Run(int argc, char** argv) {
   CLI::App app{
       "keyplace: compact maps of stable FLIRT keypoints from 2D laser logs, and place recognition "
       "(global localization, loop closure) against them.\n"
-      "Logs are CARMEN text files, plain or .gz, or ROS 1 bags (--scan-topic, --odom-topic, "
+      "Logs are CARMEN text files, plain or .gz, ROS 1 bags or ROS 2 bags (rosbag2 directory, "
+      ".mcap or .db3; --scan-topic, --odom-topic, "
       "--laser-pose; docs/ROS.md)."};
   app.set_version_flag("--version", "keyplace 0.1.0");
   app.require_subcommand(1);

@@ -188,9 +188,11 @@ void RegisterMapCommand(CLI::App& app) {
       "map",
       "Build a global map of submaps of stable FLIRT keypoints from a log (paper Algorithms 1-2) "
       "and print the mapping criteria of the paper's Section 5.1.");
-  command->add_option("input", options->input, "CARMEN log (.log, .log.gz) or ROS 1 bag")
+  command
+      ->add_option("input", options->input,
+                   "CARMEN log (.log, .log.gz), ROS 1 bag or ROS 2 bag (directory, .mcap, .db3)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command
       ->add_option("--poses", options->poses,
                    "Pose of each scan: corrected (the log's SLAM poses), odometry (raw "

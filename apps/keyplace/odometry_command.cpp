@@ -116,9 +116,9 @@ void RegisterOdometryCommand(CLI::App& app) {
       "odometry.KEY=VALUE and odometry.icp.KEY=VALUE (keyplace dump-config lists them).");
   command
       ->add_option("input", options->input,
-                   "raw CARMEN log with odometry (.log, .log.gz) or ROS 1 bag")
+                   "raw CARMEN log with odometry (.log, .log.gz), ROS 1 bag or ROS 2 bag")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command->add_option("--out", options->out_path,
                       "write the ICP trajectory as TSV: ipc timestamp (s), x (m), y (m), theta "
                       "(rad), one row per scan in processing order");

@@ -9,9 +9,9 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
                         const std::string& poses_help) {
   command
       ->add_option("--log", options.log_path,
-                   "Query log (corrected or raw CARMEN log, or ROS 1 bag)")
+                   "Query log (corrected or raw CARMEN log, or ROS 1 or ROS 2 bag)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command->add_option("--poses", options.poses, poses_help)
       ->check(CLI::IsMember({"corrected", "icp", "odometry"}))
       ->capture_default_str();

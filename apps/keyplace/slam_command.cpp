@@ -129,9 +129,11 @@ void RegisterSlamCommand(CLI::App& app) {
       "ATE/RPE and relation errors. Tuning: --set slam.KEY=VALUE (e.g. "
       "slam.exclude_recent_submaps, slam.gate_base_m=0 for no gate, slam.loop_refinement.refine), "
       "--set mapping.KEY=VALUE, --set place.KEY=VALUE, --preset paper.");
-  command->add_option("input", options->input, "raw CARMEN log (.log, .log.gz) or ROS 1 bag")
+  command
+      ->add_option("input", options->input,
+                   "raw CARMEN log (.log, .log.gz), ROS 1 bag or ROS 2 bag")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   command->add_option("--out", options->out_path, "write the SLAM map (.kpm)");
   command->add_option("--grid", options->grid_path,
                       "write an occupancy grid of the scans at the SLAM poses for ROS map_server "

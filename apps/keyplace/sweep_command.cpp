@@ -211,9 +211,10 @@ void RegisterSweepCommand(CLI::App& app) {
       "mapping",
       "Mapping criteria of Section 5.1 (compression, #scans, #keypoints, distribution, "
       "#submaps, time) over a grid of s_min and l_g (Figure 8).");
-  mapping_command->add_option("--log", mapping->log_path, "CARMEN log (.log, .log.gz) or ROS 1 bag")
+  mapping_command
+      ->add_option("--log", mapping->log_path, "CARMEN log (.log, .log.gz), ROS 1 bag or ROS 2 bag")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   mapping_command
       ->add_option("--poses", mapping->poses,
                    "corrected, odometry or icp (default: corrected when the log has them)")

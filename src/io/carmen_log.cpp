@@ -25,6 +25,7 @@
 #include "io/file_fingerprint.hpp"
 #include "io/sqlite_magic.hpp"
 #include "keyplace/io/ros1_bag.hpp"
+#include "keyplace/io/ros2_bag.hpp"
 
 namespace keyplace {
 namespace {
@@ -751,8 +752,7 @@ void ReadLines(const std::string& path, LineReader& reader, ReaderState& state,
 
 // A bag read as a log, with the beam counts the line reader keeps as it goes, and without beams
 // when the options say so.
-CarmenLog BagLog(const std::string& path, const CarmenReadOptions& options) {
-  CarmenLog log = ReadRos1Bag(path, options.bag, options.max_coordinate_m);
+CarmenLog BagLog(CarmenLog log, const CarmenReadOptions& options) {
   for (std::size_t k = 0; k < log.scans.size(); ++k) {
     CountBeams(log.scans[k], k == 0, log);
     if (!options.keep_beams) ReleaseBeams(log.scans[k]);
@@ -783,7 +783,12 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   if (!(options.max_coordinate_m > 0.0)) {
     throw std::invalid_argument("CarmenReadOptions.max_coordinate_m must be positive");
   }
-  if (IsRos1Bag(path)) return BagLog(path, options);
+  if (IsRos2Bag(path)) {
+    return BagLog(ReadRos2Bag(path, options.bag, options.max_coordinate_m), options);
+  }
+  if (IsRos1Bag(path)) {
+    return BagLog(ReadRos1Bag(path, options.bag, options.max_coordinate_m), options);
+  }
   ReaderState state;
   state.options = options;
   state.log.path = path;
@@ -831,7 +836,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
 CarmenLog ReadCarmenLogWithScans(const std::string& path, const CarmenReadOptions& options) {
   CarmenLog log = ReadCarmenLog(path, options);
   if (log.scans.empty()) {
-    // A bag without scans is an error in ReadRos1Bag, naming the topic.
+    // A bag without scans is an error in ReadRos1Bag and ReadRos2Bag, naming the topic.
     throw std::invalid_argument(path +
                                 ": no laser scans (FLASER, RLASER or ROBOTLASER1 lines) in " +
                                 std::to_string(log.lines) + " lines: is this a CARMEN log?");

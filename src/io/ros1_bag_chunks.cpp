@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "io/chunk_limits.hpp"
 #include "io/ros1_bag_source.hpp"
 
 namespace keyplace {
@@ -70,8 +71,13 @@ class ChunkWalker {
  public:
   ChunkWalker(const std::string& path, const std::set<std::string>& topics,
               const RawMessageVisitor& visitor)
-      : path_(path), topics_(topics), visitor_(visitor), file_(path, std::ios::binary) {
+      : path_(path),
+        topics_(topics),
+        visitor_(visitor),
+        file_(path, std::ios::binary | std::ios::ate) {
     if (!file_) throw std::invalid_argument(path + ": cannot open the bag");
+    file_bytes_ = static_cast<std::uint64_t>(file_.tellg());
+    file_.seekg(0);
   }
 
   BagSummary Walk() {
@@ -112,13 +118,23 @@ class ChunkWalker {
     if (!file_.read(reinterpret_cast<char*>(length_bytes), 4)) {
       return file_.gcount() == 0 ? ReadResult::kEnd : ReadResult::kCut;
     }
+    // A length beyond the file's end is a cut record: nothing is allocated for it.
     const std::uint32_t header_bytes = ReadU32(length_bytes);
-    if (header_bytes > kMaxRecordBytes || !ReadBlock(header, header_bytes)) return ReadResult::kCut;
+    if (header_bytes > BytesLeft(offset + 4) || !ReadBlock(header, header_bytes)) {
+      return ReadResult::kCut;
+    }
     if (!file_.read(reinterpret_cast<char*>(length_bytes), 4)) return ReadResult::kCut;
     const std::uint32_t data_bytes = ReadU32(length_bytes);
-    if (data_bytes > kMaxRecordBytes || !ReadBlock(data, data_bytes)) return ReadResult::kCut;
+    if (data_bytes > BytesLeft(offset + 8 + header_bytes) || !ReadBlock(data, data_bytes)) {
+      return ReadResult::kCut;
+    }
     offset += 8ULL + header_bytes + data_bytes;
     return ReadResult::kRecord;
+  }
+
+  std::uint64_t BytesLeft(std::uint64_t offset) const {
+    const std::uint64_t left = offset < file_bytes_ ? file_bytes_ - offset : 0;
+    return left < kMaxRecordBytes ? left : kMaxRecordBytes;
   }
 
   bool ReadBlock(std::vector<std::uint8_t>& block, std::uint32_t bytes) {
@@ -136,7 +152,10 @@ class ChunkWalker {
     if (kind == "none") {
       chunk = std::move(compressed);
     } else if (kind == "bz2" || kind == "lz4") {
-      if (size > kMaxRecordBytes) FailChunk(offset, "uncompressed size " + std::to_string(size));
+      if (!PlausibleChunkBytes(size, compressed.size())) {
+        FailChunk(offset, "uncompressed size " + std::to_string(size) + " from " +
+                              std::to_string(compressed.size()) + " compressed bytes");
+      }
       chunk.resize(size);
       unsigned int produced = size;
       auto* in = reinterpret_cast<char*>(compressed.data());
@@ -243,6 +262,7 @@ class ChunkWalker {
   const std::set<std::string>& topics_;
   const RawMessageVisitor& visitor_;
   std::ifstream file_;
+  std::uint64_t file_bytes_ = 0;
   std::map<std::uint32_t, Connection> connections_;
   std::map<std::string, std::size_t> counts_;
   std::size_t messages_ = 0;
@@ -253,6 +273,45 @@ class ChunkWalker {
 };
 
 }  // namespace
+
+void CheckBagRecords(const std::string& path) {
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  const auto file_bytes = static_cast<std::uint64_t>(file.tellg());
+  std::uint64_t offset = kMagicBytes;
+  std::vector<std::uint8_t> header;
+  const auto fail = [&offset](const std::string& why) {
+    throw BagIndexError("record at byte " + std::to_string(offset) + ": " + why);
+  };
+  while (file && offset < file_bytes) {
+    std::uint8_t length_bytes[4];
+    file.seekg(static_cast<std::streamoff>(offset));
+    if (file_bytes - offset < 8 || !file.read(reinterpret_cast<char*>(length_bytes), 4)) {
+      fail("cut off");
+    }
+    const std::uint32_t header_bytes = ReadU32(length_bytes);
+    if (header_bytes > file_bytes - offset - 8) fail("its header runs past the end of the file");
+    header.resize(header_bytes);
+    if ((header_bytes > 0 && !file.read(reinterpret_cast<char*>(header.data()), header_bytes)) ||
+        !file.read(reinterpret_cast<char*>(length_bytes), 4)) {
+      fail("cut off");
+    }
+    const std::uint32_t data_bytes = ReadU32(length_bytes);
+    if (data_bytes > file_bytes - offset - 8 - header_bytes) {
+      fail("its data run past the end of the file");
+    }
+    const auto fields = ParseFields(header.data(), header.size());
+    if (!fields) fail("a damaged header");
+    const auto op = fields->find("op");
+    const auto compression = fields->find("compression");
+    if (op != fields->end() && op->second == std::string(1, static_cast<char>(kOpChunk)) &&
+        compression != fields->end() && compression->second != "none" &&
+        !PlausibleChunkBytes(FieldU32(*fields, "size"), data_bytes)) {
+      fail("a chunk claiming " + std::to_string(FieldU32(*fields, "size")) +
+           " bytes uncompressed from " + std::to_string(data_bytes));
+    }
+    offset += 8ULL + header_bytes + data_bytes;
+  }
+}
 
 BagSummary VisitBagChunks(const std::string& path, const std::set<std::string>& topics,
                           const RawMessageVisitor& visitor) {

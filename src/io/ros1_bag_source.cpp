@@ -12,6 +12,7 @@ namespace {
 
 // rosbag's open either works or throws; the bag is closed when this goes out of scope.
 std::unique_ptr<rosbag::Bag> OpenIndexed(const std::string& path) {
+  CheckBagRecords(path);
   auto bag = std::make_unique<rosbag::Bag>();
   try {
     bag->open(path, rosbag::bagmode::Read);

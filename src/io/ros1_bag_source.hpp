@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "keyplace/io/carmen_log.hpp"
+#include "io/bag_log.hpp"
 
 namespace keyplace {
 
@@ -27,21 +27,19 @@ struct RawBagMessage {
 
 using RawMessageVisitor = std::function<void(const RawBagMessage&)>;
 
-/// What a walk over a bag found besides the messages.
-struct BagSummary {
-  std::vector<LogTopic> topics;       // every topic, with its type and message count
-  std::vector<std::string> warnings;  // what was dropped, naming the bag
-  std::size_t messages = 0;           // in the bag (the complete chunks for a walked one)
-};
-
 /// Thrown by VisitIndexedBag when rosbag cannot open the bag (no or damaged index, cut off).
 struct BagIndexError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The messages on `topics` in time order, through rosbag. Throws BagIndexError when the bag
-/// cannot be opened, std::invalid_argument naming the bag and topic when a chunk cannot be read
-/// (e.g. an unknown compression).
+/// Throws BagIndexError unless every record of the bag lies within the file and every compressed
+/// chunk claims a plausible uncompressed size (chunk_limits.hpp): rosbag trusts these lengths and
+/// allocates what they say (a hostile 4-byte field made it ask for 1.1 GB).
+void CheckBagRecords(const std::string& path);
+
+/// The messages on `topics` in time order, through rosbag (after CheckBagRecords). Throws
+/// BagIndexError when the bag cannot be opened, std::invalid_argument naming the bag and topic when
+/// a chunk cannot be read (e.g. an unknown compression).
 BagSummary VisitIndexedBag(const std::string& path, const std::set<std::string>& topics,
                            const RawMessageVisitor& visitor);
 

@@ -3,7 +3,6 @@
 // (compressed data cut off) naming the file; anything else, and a log that breaks the reader's
 // documented guarantees, is a finding.
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -11,51 +10,14 @@
 
 #include "fuzz_input_file.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "log_checks.hpp"
 
 namespace {
-
-using keyplace::fuzz::Finding;
-
-bool Finite(const keyplace::Pose2& pose) {
-  return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.theta);
-}
-
-// What every log the reader accepts guarantees (carmen_log.hpp, laser_scan.hpp,
-// docs/RELIABILITY.md): beams within the cap with one angle and one validity flag each, finite
-// angles and poses, valid beams with usable ranges.
-void CheckLog(const keyplace::CarmenLog& log) {
-  for (const keyplace::LogScan& scan : log.scans) {
-    const std::string where = "scan of line " + std::to_string(scan.line);
-    if (scan.size() > keyplace::kMaxScanBeams) Finding(where + ": more beams than kMaxScanBeams");
-    if (scan.angles_rad.size() != scan.size() || scan.valid.size() != scan.size()) {
-      Finding(where + ": ranges, angles and valid flags differ in length");
-    }
-    for (std::size_t i = 0; i < scan.size(); ++i) {
-      if (!std::isfinite(scan.angles_rad[i])) Finding(where + ": a beam angle is not finite");
-      const double range = scan.ranges_m[i];
-      if (scan.valid[i] != 0 &&
-          !(std::isfinite(range) && range >= 0.0 && range < scan.max_range_m)) {
-        Finding(where + ": a beam marked valid has an unusable range");
-      }
-    }
-    if (!Finite(scan.logged_laser_pose) || !Finite(scan.T_robot_laser) ||
-        (scan.odometry_pose && !Finite(*scan.odometry_pose)) ||
-        (scan.corrected_pose && !Finite(*scan.corrected_pose))) {
-      Finding(where + ": a pose is not finite");
-    }
-  }
-  for (const keyplace::OdometryMessage& odometry : log.odometry) {
-    if (!Finite(odometry.pose)) Finding("an ODOM pose is not finite");
-  }
-  if (log.skipped_line_numbers.size() > keyplace::CarmenLog::kMaxListedSkippedLines) {
-    Finding("more skipped line numbers listed than kMaxListedSkippedLines");
-  }
-}
 
 // Reads the file; true when it was rejected with a documented error.
 bool Read(const std::string& path, const keyplace::CarmenReadOptions& options) {
   try {
-    CheckLog(keyplace::ReadCarmenLog(path, options));
+    keyplace::fuzz::CheckLog(keyplace::ReadCarmenLog(path, options));
     return false;
   } catch (const std::invalid_argument& error) {
     keyplace::fuzz::ExpectNamedError("std::invalid_argument", error.what(), path);

@@ -235,13 +235,16 @@ TEST_F(PipeInput, MapFileIsRefusedAsALogNamingThePath) {
   }
 }
 
+// A directory is read as a ROS 2 bag (rosbag2 directory); one without metadata.yaml is not.
 TEST_F(PipeInput, DirectoryIsAnErrorNamingIt) {
   const std::string dir = testing::MakeTempDir("dir");
   try {
     ReadCarmenLog(dir);
     FAIL() << "no error";
-  } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find(dir + ": is a directory"), std::string::npos);
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find(dir + ": a directory without metadata.yaml"),
+              std::string::npos)
+        << error.what();
   }
 }
 

@@ -184,6 +184,18 @@ TEST(Ros1Bag, ABagCutBeforeItsFirstChunkEndsIsAnError) {
   ExpectContains(error, "rosbag cannot open it either");
 }
 
+// A cut bag's chunk claiming 512 MiB uncompressed from 95 kB of bz2 is refused before anything
+// that large is allocated (laser data do not compress 1000-fold).
+TEST(Ros1Bag, AChunkClaimingAnImplausibleSizeIsRefused) {
+  std::string bytes = ReadBytes(Fr079Bag()).substr(0, 150000);
+  const auto size_field = bytes.find("size=", bytes.find("compression=bz2"));
+  ASSERT_NE(size_field, std::string::npos);
+  bytes.replace(size_field + 5, 4, std::string("\0\0\0\x20", 4));
+  const std::string path = WriteBytes("huge.bag", bytes);
+  const std::string error = ErrorOf(path, {});
+  ExpectContains(error, path + ": chunk at byte 4117: uncompressed size 536870912 from ");
+}
+
 TEST(Ros1Bag, AnUnknownCompressionIsNamed) {
   std::string bytes = ReadBytes(Fr079Bag());
   std::size_t patched = 0;

@@ -1,6 +1,7 @@
 #pragma once
 // Reader for CARMEN text logs (plain or gzip-compressed), and the log structure every command
-// reads: ReadCarmenLog also reads a ROS 1 bag into it (ros1_bag.hpp), told apart by content.
+// reads: ReadCarmenLog also reads a ROS 1 bag (ros1_bag.hpp) or a ROS 2 bag (ros2_bag.hpp) into
+// it, told apart by content.
 
 #include <cstddef>
 #include <cstdint>
@@ -63,7 +64,8 @@ struct LogTopic {
 
 struct CarmenLog {
   std::string path;
-  // "CARMEN log" or "ROS 1 bag"; for a bag the topics it holds (every one, not only those read).
+  // "CARMEN log", "ROS 1 bag" or "ROS 2 bag"; for a bag the topics it holds (every one, not only
+  // those read).
   std::string format = "CARMEN log";
   std::vector<LogTopic> topics;
   std::vector<LogScan> scans;  // FLASER / RLASER / ROBOTLASER1 in file order
@@ -119,17 +121,19 @@ struct CarmenReadOptions {
   // summary of a log (keyplace info) holds about 200 bytes per scan instead of 17 per beam. The
   // scans then have size() 0; only their stamps and poses are kept.
   bool keep_beams = true;
-  // How a ROS 1 bag becomes a log (topics, frames, laser pose); unused for CARMEN logs.
+  // How a ROS 1 or ROS 2 bag becomes a log (topics, frames, laser pose); unused for CARMEN logs.
   BagInputConfig bag;
 };
 
 /// Reads a CARMEN log, or a ROS 1 bag (a regular file starting with "#ROSBAG V2.0", whatever
-/// its name) with ReadRos1Bag(path, options.bag). Throws std::invalid_argument naming file, line
-/// and field on malformed input (unless options.skip_bad_lines), std::runtime_error when the file
-/// cannot be opened or its compressed data are truncated. A last line without end of line that does
-/// not parse is dropped with a warning (CarmenLog::warnings): what a logger killed mid-line leaves.
-/// The file is opened once and read once, front to back, so it may be a pipe, a FIFO or
-/// /dev/fd/N; an SQLite file (a map) is an error saying so.
+/// its name) with ReadRos1Bag(path, options.bag), or a ROS 2 bag (a directory, a metadata.yaml,
+/// an MCAP file or an SQLite *.db3 file: IsRos2Bag) with ReadRos2Bag(path, options.bag). Throws
+/// std::invalid_argument naming file, line and field on malformed input (unless
+/// options.skip_bad_lines), std::runtime_error when the file cannot be opened or its compressed
+/// data are truncated. A last line without end of line that does not parse is dropped with a
+/// warning (CarmenLog::warnings): what a logger killed mid-line leaves. The file is opened once and
+/// read once, front to back, so it may be a pipe, a FIFO or /dev/fd/N; an SQLite file (a map) is an
+/// error saying so.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
 /// ReadCarmenLog, and throws std::invalid_argument naming the file when it holds no laser scan

@@ -1,4 +1,4 @@
-#include "io/ros1_bag_poses.hpp"
+#include "io/bag_log.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -40,9 +40,9 @@ std::string Seconds(double seconds) {
 
 class PoseAssembler {
  public:
-  PoseAssembler(const std::string& path, const BagInputConfig& config, const BagSummary& summary,
-                BagContents& contents)
-      : path_(path), config_(config), summary_(summary), contents_(contents) {}
+  PoseAssembler(const std::string& path, const BagInputConfig& config, const BagTypeNames& types,
+                const BagSummary& summary, BagContents& contents)
+      : path_(path), config_(config), types_(types), summary_(summary), contents_(contents) {}
 
   void CheckScans() const {
     const std::string& topic = config_.scan_topic;
@@ -50,7 +50,7 @@ class PoseAssembler {
       Fail("no topic " + topic + " (input.scan_topic, --scan-topic); the bag has " +
            TopicList(summary_));
     }
-    CheckType(topic, "sensor_msgs/LaserScan");
+    CheckType(topic, types_.scan);
     if (contents_.scans.empty()) Fail("topic " + topic + " holds no scan");
   }
 
@@ -58,7 +58,7 @@ class PoseAssembler {
   void AddOdometry(CarmenLog& log) {
     const std::string& topic = config_.odom_topic;
     if (FindTopic(summary_, topic) != nullptr) {
-      CheckType(topic, "nav_msgs/Odometry");
+      CheckType(topic, types_.odometry);
       if (contents_.odometry.empty()) Fail("topic " + topic + " holds no odometry message");
       std::vector<StampedPose> samples;
       for (const OdometryMessage& message : contents_.odometry) {
@@ -158,6 +158,7 @@ class PoseAssembler {
 
   const std::string& path_;
   const BagInputConfig& config_;
+  const BagTypeNames& types_;
   const BagSummary& summary_;
   BagContents& contents_;
 };
@@ -165,12 +166,13 @@ class PoseAssembler {
 }  // namespace
 
 CarmenLog AssembleBagLog(const std::string& path, const BagInputConfig& config,
-                         const BagSummary& summary, BagContents&& contents) {
-  PoseAssembler assembler(path, config, summary, contents);
+                         const BagTypeNames& types, const BagSummary& summary,
+                         BagContents&& contents) {
+  PoseAssembler assembler(path, config, types, summary, contents);
   assembler.CheckScans();
   CarmenLog log;
   log.path = path;
-  log.format = "ROS 1 bag";
+  log.format = types.format;
   log.topics = summary.topics;
   log.warnings = summary.warnings;
   log.scans = std::move(contents.scans);
