@@ -15,11 +15,12 @@ int LargestRigidStar(const std::vector<DescriptorPair>& pairs,
     const Eigen::Vector2d& current_a = current_positions[pairs[a].current];
     const Eigen::Vector2d& reference_a = reference_positions[pairs[a].reference];
     for (std::size_t b = a + 1; b < n; ++b) {
-      // The same test, in the same arithmetic, as EstimateRigidTransformRansac's samples.
+      // The test, in the same arithmetic, of EstimateRigidTransformRansac's samples.
       const double d_cur = (current_a - current_positions[pairs[b].current]).squaredNorm();
       const double d_ref = (reference_a - reference_positions[pairs[b].reference]).squaredNorm();
       if (d_cur <= 0.0 || d_ref <= 0.0) continue;
-      if ((d_cur - d_ref) * (d_cur - d_ref) / (8.0 * (d_cur + d_ref)) > rigidity_m2) continue;
+      // Written as "not within" so that a non-finite keypoint agrees with nothing.
+      if (!((d_cur - d_ref) * (d_cur - d_ref) / (8.0 * (d_cur + d_ref)) <= rigidity_m2)) continue;
       ++agreeing[a];
       ++agreeing[b];
     }

@@ -17,6 +17,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -431,13 +432,18 @@ TEST(MapFile, AJournalBesideTheMapIsNeitherReadNorApplied) {
 }
 
 TEST(MapFile, StoredConfigIsValidatedLikeAUsersNamingFileAndKey) {
-  for (const char* value : {"0.001", "inf", "nan", "1e300"}) {
+  // Out of range, or not finite (refused as it is read, before the range check).
+  for (const auto& [value, reason] :
+       std::vector<std::pair<const char*, const char*>>{{"0.001", "[0.01, 10] m"},
+                                                        {"inf", "'inf' is not finite"},
+                                                        {"nan", "'nan' is not finite"},
+                                                        {"1e300", "[0.01, 10] m"}}) {
     SCOPED_TRACE(value);
     const std::string path = SavedRandomMap("config.kpm");
     ExecuteSql(path,
                std::string("UPDATE config SET value = '") + value + "' WHERE key = 'cell_size_m'");
     Reseal(path);
-    ExpectRejected(path, {"table config: ", "cell_size_m", "[0.01, 10] m"});
+    ExpectRejected(path, {"table config: ", "cell_size_m", reason});
   }
   const std::string path = SavedRandomMap("grid.kpm");
   ExecuteSql(path, "UPDATE config SET value = '1099511627776' WHERE key = 'max_grid_cells'");
