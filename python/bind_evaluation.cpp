@@ -236,8 +236,11 @@ void BindSlam(py::module_& module) {
                              [](const SlamEvaluation& e) { return e.loops.truth_evaluated; })
       .def_property_readonly(
           "loop_precision_overlap_30",
-          [](const SlamEvaluation& e) { return e.precision.overlap_30; },
-          "Share of detected loops whose submaps overlap by >= 30 %.")
+          [](const SlamEvaluation& e) -> py::object {
+            if (e.loops.overlap.empty()) return py::none();  // no loops: no share
+            return py::float_(e.precision.overlap_30);
+          },
+          "Share of detected loops whose submaps overlap by >= 30 % (None without loops).")
       .def_property_readonly(
           "ate_rmse_m",
           [](const SlamEvaluation& e) -> py::object {

@@ -47,6 +47,15 @@ nlohmann::json RelationJson(const RelationErrorReport& r) {
   json["all"] = StatsJson(r.all);
   json["local"] = StatsJson(r.local);
   json["loop"] = StatsJson(r.loop);
+  // A split without relations has no error, not an error of 0.
+  for (const char* split : {"local", "loop"}) {
+    if (json[split]["count"] != 0) continue;
+    for (const char* stat :
+         {"translation_mean_m", "translation_std_m", "rotation_mean_deg", "rotation_std_deg"}) {
+      json[std::string(split) + "_" + stat] = nullptr;
+    }
+    json[split] = nullptr;
+  }
   return json;
 }
 

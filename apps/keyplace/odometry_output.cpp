@@ -13,6 +13,10 @@ namespace keyplace::cli {
 namespace {
 
 void PrintStatsRow(const std::string& label, const ErrorStats& s) {
+  if (s.count == 0) {
+    fmt::print("  {:<10} {:>5}  no relations\n", label, 0);
+    return;
+  }
   fmt::print(
       "  {:<10} {:>5}  {:8.4f} ± {:<8.4f} m  {:7.3f} ± {:<7.3f} deg  (max {:.3f} m, {:.2f} deg)\n",
       label, s.count, s.translation_mean_m, s.translation_std_m, s.rotation_mean_deg,

@@ -47,8 +47,13 @@ void PrintLoopPrecision(const SlamReport& r) {
     fmt::print("loop precision     no loops\n");
     return;
   }
-  fmt::print("loop precision     {:.3f} at 10 % overlap, {:.3f} at 30 % ({:.3f} of the used)\n",
-             p.overlap_10, p.overlap_30, p.used_overlap_30);
+  fmt::print("loop precision     {:.3f} at 10 % overlap, {:.3f} at 30 % ", p.overlap_10,
+             p.overlap_30);
+  if (ev.used_count == 0) {
+    fmt::print("(none used)\n");
+  } else {
+    fmt::print("({:.3f} of the used)\n", p.used_overlap_30);
+  }
   fmt::print("                   {:.3f} at 30 % with 0.2 m cells (sensitivity of the measure)\n",
              p.cells_0_2m_30);
   fmt::print(

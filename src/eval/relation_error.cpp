@@ -57,8 +57,8 @@ class StampIndex {
 
   // Whether `stamp_s` lies within the first..last stamp, widened by the tolerance.
   bool Spans(double stamp_s, double tolerance_s) const {
-    return !stamps_.empty() && stamp_s >= stamps_.front() - tolerance_s &&
-           stamp_s <= stamps_.back() + tolerance_s;
+    return !stamps_.empty() && stamps_.front() - stamp_s <= tolerance_s &&
+           stamp_s - stamps_.back() <= tolerance_s;
   }
 
   // The trajectory index of the nearest stamp within tolerance_s; ties go to the earlier stamp,
@@ -88,17 +88,19 @@ class StampIndex {
 std::string RefusalOf(const RelationErrorReport& report, const RelationErrorConfig& config) {
   const std::size_t inside = report.matched + report.unmatched;
   if (report.relations == 0) return "the relation file holds no relation";
+  if (report.trajectory_poses == 0) return "the trajectory has no pose";
   if (inside == 0) {
     return "no relation lies within the trajectory's time span (" +
            std::to_string(report.outside_span) +
            " outside it): the relation file belongs to another log";
   }
   const double fraction = static_cast<double>(report.matched) / static_cast<double>(inside);
-  if (fraction >= config.min_matched_fraction) return "";
+  if (report.matched > 0 && fraction >= config.min_matched_fraction) return "";
   char numbers[96];
   std::snprintf(numbers, sizeof(numbers),
-                " (%.1f %%) matched a scan stamp within %g ms, below %g %%", 100.0 * fraction,
-                1e3 * config.stamp_tolerance_s, 100.0 * config.min_matched_fraction);
+                " (%.1f %%) matched a scan stamp within %g ms, below %g %%",
+                std::floor(1000.0 * fraction) / 10.0, 1e3 * config.stamp_tolerance_s,
+                100.0 * config.min_matched_fraction);
   return "only " + std::to_string(report.matched) + " of the " + std::to_string(inside) +
          " relations inside the trajectory's time span" + numbers +
          ": the relation file belongs to another log, or its stamps differ from the log's";
@@ -140,6 +142,7 @@ RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
   ValidateRelationConfig(config);
   RelationErrorReport report;
   report.relations = relations.size();
+  report.trajectory_poses = trajectory.size();
   const StampIndex stamps(trajectory);
   report.duplicate_timestamps = stamps.duplicates();
   std::vector<double> t_all, r_all, t_local, r_local, t_loop, r_loop;

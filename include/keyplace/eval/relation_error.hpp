@@ -64,7 +64,8 @@ struct RelationErrorItem {
 };
 
 struct RelationErrorReport {
-  std::size_t relations = 0;  // relations given
+  std::size_t relations = 0;         // relations given
+  std::size_t trajectory_poses = 0;  // poses of the trajectory evaluated
   // Relations with a stamp outside the trajectory's first..last stamp (e.g. a slice of the log):
   // not evaluated, and not held against the matched fraction.
   std::size_t outside_span = 0;
