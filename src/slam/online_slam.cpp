@@ -25,6 +25,10 @@ void Validate(const SlamConfig& config) {
     throw std::invalid_argument("SlamConfig." + field + ": " + why);
   };
   if (config.exclude_recent_submaps < 0) fail("exclude_recent_submaps", "must be >= 0");
+  if (config.all_scan_loop_queries &&
+      config.place.query_keypoints != PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+    fail("all_scan_loop_queries", "needs place.query_keypoints = all_scans");
+  }
   if (!(config.exclude_recent_path_m >= 0.0)) fail("exclude_recent_path_m", "must be >= 0");
   if (!(config.gate_base_m >= 0.0)) fail("gate_base_m", "must be >= 0");
   if (!(config.gate_per_path >= 0.0)) fail("gate_per_path", "must be >= 0");

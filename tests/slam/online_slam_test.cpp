@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -108,10 +109,9 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   std::vector<std::vector<Keypoint>> keypoints;
   keypoints.reserve(run.scans.size());
   for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
-  auto loops_found = [&](PlaceRecognitionConfig::QueryKeypoints query_keypoints) {
+  auto loops_found = [&](bool all_scan_loop_queries) {
     SlamConfig config = SimulationConfig();
-    config.all_scan_loop_queries = true;
-    config.place.query_keypoints = query_keypoints;
+    config.all_scan_loop_queries = all_scan_loop_queries;
     config.place.min_gamma = 1.0;
     OnlineSlam slam(config);
     for (std::size_t i = 0; i < run.scans.size(); ++i) {
@@ -120,8 +120,13 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
     slam.Finish();
     return slam.loops().size();
   };
-  EXPECT_EQ(loops_found(PlaceRecognitionConfig::QueryKeypoints::kStable), 0U);
-  EXPECT_GE(loops_found(PlaceRecognitionConfig::QueryKeypoints::kAllScans), 1U);
+  EXPECT_EQ(loops_found(false), 0U);  // the default: stable-keypoint queries
+  EXPECT_GE(loops_found(true), 1U);
+  // The switch needs all-scan query keypoints in the place configuration.
+  SlamConfig stable = SimulationConfig();
+  stable.all_scan_loop_queries = true;
+  stable.place.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
+  EXPECT_THROW(OnlineSlam{stable}, std::invalid_argument);
 }
 
 TEST(OnlineSlam, RejectsInvalidConfig) {
