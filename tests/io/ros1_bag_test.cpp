@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "keyplace/io/carmen_log.hpp"
+#include "support/expect_contains.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -60,10 +61,7 @@ std::string ErrorOf(const std::string& path, const BagInputConfig& config) {
   return "no error";
 }
 
-void ExpectContains(const std::string& text, const std::string& fragment) {
-  EXPECT_NE(text.find(fragment), std::string::npos)
-      << "'" << text << "' lacks '" << fragment << "'";
-}
+using testing::ExpectContains;
 
 long Microseconds(double stamp_s) { return std::lround(stamp_s * 1e6); }
 

@@ -16,6 +16,7 @@
 
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/io/ros1_bag.hpp"
+#include "support/expect_contains.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -107,10 +108,7 @@ std::string ErrorOf(const std::string& path, const BagInputConfig& config = {}) 
   return "no error";
 }
 
-void ExpectContains(const std::string& text, const std::string& fragment) {
-  EXPECT_NE(text.find(fragment), std::string::npos)
-      << "'" << text << "' lacks '" << fragment << "'";
-}
+using testing::ExpectContains;
 
 TEST(Ros1BagWritten, OdometryFromATfChainInterpolatedOnTheCircle) {
   Content content;

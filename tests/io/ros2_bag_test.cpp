@@ -18,6 +18,7 @@
 
 #include "io/ros2_cdr.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "support/expect_contains.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -59,10 +60,7 @@ std::string ErrorOf(const std::string& path, const BagInputConfig& config = {}) 
   return "no error";
 }
 
-void ExpectContains(const std::string& text, const std::string& fragment) {
-  EXPECT_NE(text.find(fragment), std::string::npos)
-      << "'" << text << "' lacks '" << fragment << "'";
-}
+using testing::ExpectContains;
 
 void Replace(std::string& text, const std::string& from, const std::string& to) {
   for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
