@@ -1,5 +1,8 @@
 #include "eval_json.hpp"
 
+#include <string>
+#include <utility>
+
 namespace keyplace::cli {
 
 nlohmann::json StatsJson(const ErrorStats& s) {
@@ -12,6 +15,24 @@ nlohmann::json StatsJson(const ErrorStats& s) {
           {"rotation_max_deg", s.rotation_max_deg}};
 }
 
+namespace {
+
+// One split's flat keys for scripts (prefix "" for all relations) and its full statistics under
+// `name`; all null when the split has no error to give.
+void AddSplit(const std::string& prefix, const char* name, const ErrorStats& s, bool known,
+              nlohmann::json& json) {
+  const std::pair<const char*, double> flat[] = {{"translation_mean_m", s.translation_mean_m},
+                                                 {"translation_std_m", s.translation_std_m},
+                                                 {"rotation_mean_deg", s.rotation_mean_deg},
+                                                 {"rotation_std_deg", s.rotation_std_deg}};
+  for (const auto& [key, value] : flat) {
+    json[prefix + key] = known ? nlohmann::json(value) : nlohmann::json(nullptr);
+  }
+  json[name] = known ? StatsJson(s) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
 nlohmann::json RelationJson(const RelationErrorReport& r) {
   nlohmann::json json;
   json["relations"] = r.relations;
@@ -19,43 +40,13 @@ nlohmann::json RelationJson(const RelationErrorReport& r) {
   json["unmatched"] = r.unmatched;
   json["outside_span"] = r.outside_span;
   json["duplicate_timestamps"] = r.duplicate_timestamps;
-  if (!r.refusal.empty()) {  // no error figures at all, so no script can read one by mistake
-    json["refusal"] = r.refusal;
-    for (const char* key :
-         {"translation_mean_m", "translation_std_m", "rotation_mean_deg", "rotation_std_deg",
-          "local_translation_mean_m", "local_translation_std_m", "local_rotation_mean_deg",
-          "local_rotation_std_deg", "loop_translation_mean_m", "loop_translation_std_m",
-          "loop_rotation_mean_deg", "loop_rotation_std_deg", "all", "local", "loop"}) {
-      json[key] = nullptr;
-    }
-    return json;
-  }
-  json["refusal"] = nullptr;
-  // Flat keys for scripts, then the full statistics per split.
-  json["translation_mean_m"] = r.all.translation_mean_m;
-  json["translation_std_m"] = r.all.translation_std_m;
-  json["rotation_mean_deg"] = r.all.rotation_mean_deg;
-  json["rotation_std_deg"] = r.all.rotation_std_deg;
-  json["local_translation_mean_m"] = r.local.translation_mean_m;
-  json["local_translation_std_m"] = r.local.translation_std_m;
-  json["local_rotation_mean_deg"] = r.local.rotation_mean_deg;
-  json["local_rotation_std_deg"] = r.local.rotation_std_deg;
-  json["loop_translation_mean_m"] = r.loop.translation_mean_m;
-  json["loop_translation_std_m"] = r.loop.translation_std_m;
-  json["loop_rotation_mean_deg"] = r.loop.rotation_mean_deg;
-  json["loop_rotation_std_deg"] = r.loop.rotation_std_deg;
-  json["all"] = StatsJson(r.all);
-  json["local"] = StatsJson(r.local);
-  json["loop"] = StatsJson(r.loop);
-  // A split without relations has no error, not an error of 0.
-  for (const char* split : {"local", "loop"}) {
-    if (json[split]["count"] != 0) continue;
-    for (const char* stat :
-         {"translation_mean_m", "translation_std_m", "rotation_mean_deg", "rotation_std_deg"}) {
-      json[std::string(split) + "_" + stat] = nullptr;
-    }
-    json[split] = nullptr;
-  }
+  // Refused: no error figures at all, so no script can read one by mistake. A split without
+  // relations has no error, not an error of 0.
+  const bool given = r.refusal.empty();
+  json["refusal"] = given ? nlohmann::json(nullptr) : nlohmann::json(r.refusal);
+  AddSplit("", "all", r.all, given, json);
+  AddSplit("local_", "local", r.local, given && r.local.count > 0, json);
+  AddSplit("loop_", "loop", r.loop, given && r.loop.count > 0, json);
   return json;
 }
 
