@@ -81,10 +81,6 @@ void ForEachDataLine(
 
 }  // namespace
 
-std::int64_t TimestampKey(double timestamp_s) {
-  return static_cast<std::int64_t>(std::llround(timestamp_s * 1e6));
-}
-
 std::vector<Relation> ReadRelations(const std::string& path) {
   static const char* const kFields[] = {"t_a", "t_b", "dx", "dy", "dz", "droll", "dpitch", "dyaw"};
   std::vector<Relation> relations;

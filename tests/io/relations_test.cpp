@@ -58,14 +58,6 @@ TEST(RelationsTest, MalformedLinesNameFileLineAndField) {
   EXPECT_THROW(ReadRelations("/nonexistent/file.relations"), std::runtime_error);
 }
 
-TEST(RelationsTest, TimestampKeyMatchesEqualValuesOnly) {
-  // Same value written with and without trailing zero (the Intel unpadded stamps are read as
-  // written in both the log and the relation file, so they agree as values).
-  EXPECT_EQ(TimestampKey(976052858.40413), TimestampKey(976052858.404130));
-  EXPECT_NE(TimestampKey(976052858.40413), TimestampKey(976052858.040413));
-  EXPECT_NE(TimestampKey(976052858.404130), TimestampKey(976052858.404131));
-}
-
 TEST(RelationsTest, IndexPairsWithHeader) {
   const std::string path = WriteTemp("map.tsv", "raw_index\tcorrected_index\n3541\t0\n3544\t1\n");
   const std::vector<IndexPair> pairs = ReadIndexPairs(path);

@@ -3,7 +3,6 @@
 // algorithms", and the raw -> corrected scan index maps of ../shared/data.
 
 #include <cstddef>
-#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -24,11 +23,6 @@ struct Relation {
 /// std::invalid_argument naming file, line and field on malformed lines, std::runtime_error when
 /// the file cannot be opened.
 std::vector<Relation> ReadRelations(const std::string& path);
-
-/// Key for matching timestamps exactly as values: the time in integer microseconds. Stamps
-/// written with 6 decimals (and the Intel unpadded-microsecond stamps, which are read the same
-/// way in logs and relation files) map to the same key iff their texts denote the same value.
-std::int64_t TimestampKey(double timestamp_s);
 
 /// One row of a `*-raw-to-corrected.tsv` file (0-based laser-line indices).
 struct IndexPair {
