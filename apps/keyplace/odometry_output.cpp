@@ -41,6 +41,9 @@ void PrintOdometryRun(const OdometryRun& run) {
   const OdometryRunStats& s = run.stats;
   fmt::print("scans           {} of {} ({} order)\n", s.scans, run.log_scans, ToString(run.order));
   fmt::print("registered      {}\n", s.registered);
+  fmt::print(
+      "recovered       {} (ICP failed from the prediction, converged from a searched pose)\n",
+      s.recovered);
   fmt::print("fallbacks       {} not converged, {} correction too large, {} too few points\n",
              s.not_converged, s.fallback_correction_too_large, s.fallback_too_few_points);
   fmt::print("degenerate      {}\n", s.degenerate);
@@ -55,6 +58,7 @@ nlohmann::json OdometryRunJson(const OdometryRun& run) {
           {"scans", s.scans},
           {"scans_in_log", run.log_scans},
           {"registered", s.registered},
+          {"recovered", s.recovered},
           {"not_converged", s.not_converged},
           {"fallback_correction_too_large", s.fallback_correction_too_large},
           {"fallback_too_few_points", s.fallback_too_few_points},
@@ -79,17 +83,24 @@ void PrintOdometryDrift(const OdometryDrift& drift) {
         std::pair<std::string, const DriftReport&>{"odometry", drift.odometry}}) {
     fmt::print(
         "  {:<10} consecutive {:.4f} ± {:.4f} m, {:.3f} ± {:.3f} deg; ATE rmse {:.3f} m "
-        "(max {:.3f} m), {:.2f} deg\n",
+        "(max {:.3f} m), {:.2f} deg; worst {}-step heading {:.2f} deg (from raw scan {})\n",
         name, d.consecutive.translation_mean_m, d.consecutive.translation_std_m,
         d.consecutive.rotation_mean_deg, d.consecutive.rotation_std_deg, d.ate_rmse_m, d.ate_max_m,
-        d.ate_rotation_rmse_deg);
+        d.ate_rotation_rmse_deg, kDriftWindowSteps, d.window_heading_max_deg,
+        d.window_start_raw_index);
   }
 }
 
 nlohmann::json DriftJson(const DriftReport& d) {
-  return {{"pairs", d.pairs},           {"consecutive", StatsJson(d.consecutive)},
-          {"ate_rmse_m", d.ate_rmse_m}, {"ate_mean_m", d.ate_mean_m},
-          {"ate_max_m", d.ate_max_m},   {"ate_rotation_rmse_deg", d.ate_rotation_rmse_deg}};
+  return {{"pairs", d.pairs},
+          {"consecutive", StatsJson(d.consecutive)},
+          {"ate_rmse_m", d.ate_rmse_m},
+          {"ate_mean_m", d.ate_mean_m},
+          {"ate_max_m", d.ate_max_m},
+          {"ate_rotation_rmse_deg", d.ate_rotation_rmse_deg},
+          {"window_steps", kDriftWindowSteps},
+          {"window_heading_max_deg", d.window_heading_max_deg},
+          {"window_start_raw_index", d.window_start_raw_index}};
 }
 
 void WriteRelationErrorsTsv(const std::string& path, const std::vector<Relation>& relations,

@@ -86,6 +86,16 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
                 "ICP results further than this from the odometry prediction are rejected ...")
         .Double("max_correction_rotation_rad", &C::max_correction_rotation_rad, "rad",
                 "... or turned more than this")
+        .Bool("recovery_search", &C::recovery_search,
+              "a failed or rejected ICP retries from the best pose of a correlative search")
+        .Double("recovery_window_translation_m", &C::recovery_window_translation_m, "m",
+                "the search covers this much translation around the prediction ...")
+        .Double("recovery_window_rotation_rad", &C::recovery_window_rotation_rad, "rad",
+                "... and this much rotation")
+        .Double("recovery_step_translation_m", &C::recovery_step_translation_m, "m",
+                "translation step of the search")
+        .Double("recovery_step_rotation_rad", &C::recovery_step_rotation_rad, "rad",
+                "rotation step of the search")
         .Nested("icp", &C::icp, IcpConfigFields());
     return table;
   }();

@@ -58,6 +58,9 @@ OdometryRunStats SummarizeOdometryRun(const std::vector<ScanOdometryResult>& res
         ++stats.registered;
         iterations_sum += r.iterations;
         break;
+      case ScanOdometryStatus::kRecovered:
+        ++stats.recovered;
+        break;
       case ScanOdometryStatus::kFallbackNotConverged:
         ++stats.not_converged;
         break;

@@ -214,6 +214,18 @@ DriftReport EvaluateDrift(const std::vector<Pose2>& estimate_by_raw_index,
     r_errors.push_back(error.rotation_deg);
   }
   report.consecutive = Summarize(t_errors, r_errors);
+  for (std::size_t k = kDriftWindowSteps; k < pairs.size(); ++k) {
+    const IndexPair& first = pairs[k - kDriftWindowSteps];
+    const Pose2 estimated =
+        Between(estimate_by_raw_index[first.raw_index], estimate_by_raw_index[pairs[k].raw_index]);
+    const Pose2 truth = Between(corrected_by_corrected_index[first.corrected_index],
+                                corrected_by_corrected_index[pairs[k].corrected_index]);
+    const double heading_deg = RelativePoseError(estimated, truth).rotation_deg;
+    if (heading_deg > report.window_heading_max_deg) {
+      report.window_heading_max_deg = heading_deg;
+      report.window_start_raw_index = first.raw_index;
+    }
+  }
 
   // Closed-form SE(2) alignment of the estimated positions onto the corrected ones.
   Eigen::Vector2d mean_e = Eigen::Vector2d::Zero();

@@ -7,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "correlative_search.hpp"
+
 namespace keyplace {
 namespace {
 
@@ -14,6 +16,14 @@ void Require(bool condition, const char* field, const char* what) {
   if (!condition) {
     throw std::invalid_argument(std::string("ScanOdometryConfig.") + field + " " + what);
   }
+}
+
+void RecordIcp(const IcpResult& icp, ScanOdometryResult* result) {
+  result->icp_status = icp.status;
+  result->iterations = icp.iterations;
+  result->inlier_ratio = icp.inlier_ratio;
+  result->residual_rms_m = icp.residual_rms_m;
+  result->degenerate = icp.degenerate;
 }
 
 }  // namespace
@@ -24,6 +34,8 @@ std::string ToString(ScanOdometryStatus status) {
       return "first_scan";
     case ScanOdometryStatus::kRegistered:
       return "registered";
+    case ScanOdometryStatus::kRecovered:
+      return "recovered";
     case ScanOdometryStatus::kFallbackNotConverged:
       return "fallback_not_converged";
     case ScanOdometryStatus::kFallbackCorrectionTooLarge:
@@ -48,6 +60,14 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
   Require(c.keyframe_rotation_rad >= 0.0, "keyframe_rotation_rad", "must be >= 0");
   Require(c.max_correction_translation_m > 0.0, "max_correction_translation_m", "must be > 0");
   Require(c.max_correction_rotation_rad > 0.0, "max_correction_rotation_rad", "must be > 0");
+  Require(c.recovery_window_translation_m >= 0.0 && c.recovery_window_translation_m <= 10.0,
+          "recovery_window_translation_m", "must be in [0, 10]");
+  Require(c.recovery_window_rotation_rad >= 0.0 && c.recovery_window_rotation_rad <= M_PI,
+          "recovery_window_rotation_rad", "must be in [0, pi]");
+  // The search costs (window / step)^2 translations per rotation: these floors keep one search
+  // below a few hundred million point lookups.
+  Require(c.recovery_step_translation_m >= 0.01, "recovery_step_translation_m", "must be >= 0.01");
+  Require(c.recovery_step_rotation_rad >= 0.001, "recovery_step_rotation_rad", "must be >= 0.001");
 }
 
 ScanOdometry::ScanOdometry(const ScanOdometryConfig& config) : config_(config) {
@@ -109,6 +129,33 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
   last_keyframe_T_world_laser_ = T_world_laser;
 }
 
+std::optional<IcpResult> ScanOdometry::Recover(const std::vector<Eigen::Vector2d>& source_laser,
+                                               const Pose2& predicted_T_world_laser) const {
+  CorrelativeWindow window;
+  window.translation_m = config_.recovery_window_translation_m;
+  window.rotation_rad = config_.recovery_window_rotation_rad;
+  window.translation_step_m = config_.recovery_step_translation_m;
+  window.rotation_step_rad = config_.recovery_step_rotation_rad;
+  // Closeness falls to exp(-1/8) = 0.88 half a step off a target point, so the true pose scores
+  // well on the search grid; the field covers every point the scan can reach in the window.
+  const double sigma_m = window.translation_step_m;
+  double reach_m = 0.0;
+  for (const Eigen::Vector2d& p : source_laser) reach_m = std::max(reach_m, p.norm());
+  const ProximityField field(map_points_, predicted_T_world_laser.translation(),
+                             reach_m + window.translation_m + 3.0 * sigma_m,
+                             window.translation_step_m / 2.0, sigma_m);
+  const CorrelativeMatch match =
+      SearchCorrelative(field, source_laser, predicted_T_world_laser, window);
+  IcpResult icp = AlignPointToLine(*target_, source_laser, match.T_target_source, config_.icp);
+  if (!icp.converged) return std::nullopt;
+  const Pose2 refinement = Between(match.T_target_source, icp.T_target_source);
+  if (TranslationNorm(refinement) > config_.max_correction_translation_m ||
+      std::abs(refinement.theta) > config_.max_correction_rotation_rad) {
+    return std::nullopt;
+  }
+  return icp;
+}
+
 ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
                                      const std::optional<Pose2>& T_odom_robot) {
   const auto start = std::chrono::steady_clock::now();
@@ -147,14 +194,11 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       result.status = ScanOdometryStatus::kFallbackTooFewPoints;
       result.icp_status = IcpStatus::kTooFewPoints;
     } else {
+      const std::vector<Eigen::Vector2d> source =
+          SubsampleBySpacing(points, config_.source_min_spacing_m);
       const IcpResult icp =
-          AlignPointToLine(*target_, SubsampleBySpacing(points, config_.source_min_spacing_m),
-                           predicted_T_world_laser, config_.icp);
-      result.icp_status = icp.status;
-      result.iterations = icp.iterations;
-      result.inlier_ratio = icp.inlier_ratio;
-      result.residual_rms_m = icp.residual_rms_m;
-      result.degenerate = icp.degenerate;
+          AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
+      RecordIcp(icp, &result);
       if (!icp.converged) {
         result.status = icp.status == IcpStatus::kTooFewPoints
                             ? ScanOdometryStatus::kFallbackTooFewPoints
@@ -169,8 +213,18 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
           T_world_laser = icp.T_target_source;
         }
       }
+      if (config_.recovery_search &&
+          (result.status == ScanOdometryStatus::kFallbackNotConverged ||
+           result.status == ScanOdometryStatus::kFallbackCorrectionTooLarge)) {
+        if (const std::optional<IcpResult> recovered = Recover(source, predicted_T_world_laser)) {
+          RecordIcp(*recovered, &result);
+          result.status = ScanOdometryStatus::kRecovered;
+          T_world_laser = recovered->T_target_source;
+        }
+      }
     }
-    result.converged = result.status == ScanOdometryStatus::kRegistered;
+    result.converged = result.status == ScanOdometryStatus::kRegistered ||
+                       result.status == ScanOdometryStatus::kRecovered;
     result.fell_back = !result.converged;
     result.T_world_laser = T_world_laser;
     result.T_world_robot = T_world_laser * T_robot_laser.inverse();

@@ -46,7 +46,7 @@ check "odometry json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['scans'] == 100 and j['scans_in_log'] == 1464 and j['missing_odometry'] == 100, j
-assert j['registered'] + j['not_converged'] + j['fallback_correction_too_large'] \
+assert j['registered'] + j['recovered'] + j['not_converged'] + j['fallback_correction_too_large'] \
     + j['fallback_too_few_points'] == 99, j
 c=j['config']
 assert c['odometry']['icp']['kernel'] == 'huber', c['odometry']

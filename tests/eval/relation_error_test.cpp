@@ -189,6 +189,7 @@ TEST(RelationErrorTest, DriftAgainstCorrectedPoses) {
   EXPECT_NEAR(exact.consecutive.translation_mean_m, 0.0, 1e-9);
   EXPECT_NEAR(exact.ate_rmse_m, 0.0, 1e-9);
   EXPECT_NEAR(exact.ate_rotation_rmse_deg, 0.0, 1e-7);
+  EXPECT_NEAR(exact.window_heading_max_deg, 0.0, 1e-7);
   const Pose2 T_corrected_raw = T_raw_corrected.inverse();
   EXPECT_NEAR(exact.T_corrected_estimate.theta, T_corrected_raw.theta, 1e-9);
   EXPECT_NEAR(exact.T_corrected_estimate.x, T_corrected_raw.x, 1e-9);
@@ -198,6 +199,18 @@ TEST(RelationErrorTest, DriftAgainstCorrectedPoses) {
   EXPECT_NEAR(off.consecutive.translation_max_m, 0.5, 1e-9);
   EXPECT_GT(off.ate_rmse_m, 0.05);
   EXPECT_LT(off.ate_max_m, 0.5);  // the alignment spreads the error
+
+  // A heading slip of 30 deg at raw scan 21 that the later scans keep: every window across it
+  // sees it: windows starting at raw 11..19 (pairs 5..9) end after it.
+  std::vector<Pose2> slipped = raw;
+  const Pose2 slipped_21 = raw[21] * Pose2(0.0, 0.0, 0.5236);
+  for (std::size_t i = 21; i < slipped.size(); ++i) {
+    slipped[i] = slipped_21 * Between(raw[21], raw[i]);
+  }
+  const DriftReport slip = EvaluateDrift(slipped, corrected, pairs);
+  EXPECT_NEAR(slip.window_heading_max_deg, 30.0, 0.01);
+  EXPECT_GE(slip.window_start_raw_index, 11u);
+  EXPECT_LE(slip.window_start_raw_index, 19u);
 
   pairs.push_back({40, 0});
   EXPECT_THROW(EvaluateDrift(raw, corrected, pairs), std::invalid_argument);

@@ -90,12 +90,20 @@ RelationErrorReport EvaluateRelations(const std::vector<TimedPose>& trajectory,
                                       const std::vector<Relation>& relations,
                                       const RelationErrorConfig& config = {});
 
+/// Steps of the window of DriftReport::window_heading_max_deg.
+inline constexpr std::size_t kDriftWindowSteps = 5;
+
 /// Drift of a trajectory against corrected poses, through raw -> corrected index pairs.
 struct DriftReport {
   std::size_t pairs = 0;  // index pairs used
   // Relative pose error between consecutive corrected scans (pairs sorted by corrected index):
   // estimated vs corrected relative motion. Local drift per corrected step.
   ErrorStats consecutive;
+  // The worst heading error of the relative motion across kDriftWindowSteps consecutive steps
+  // (a lost turn shows here even when the next scans register well again), and the raw index of
+  // the window's first scan.
+  double window_heading_max_deg = 0.0;
+  std::size_t window_start_raw_index = 0;
   // Absolute trajectory error after the least-squares SE(2) alignment (no scale) of the
   // estimated positions onto the corrected positions.
   double ate_rmse_m = 0.0;

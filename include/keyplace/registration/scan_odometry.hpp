@@ -43,6 +43,20 @@ struct ScanOdometryConfig {
   // rejected (fallback to odometry, flagged). Guards against converging into a wrong minimum.
   double max_correction_translation_m = 0.5;
   double max_correction_rotation_rad = 0.3490658504;  // 20 deg
+
+  // Recovery from a bad alignment. When ICP from the prediction does not converge (too few
+  // inliers, no convergence) or converges beyond the max_correction_* bounds, the prediction
+  // itself is suspect: a correlative search scores every pose of a window around it against the
+  // local map (translations ±recovery_window_translation_m in steps of
+  // recovery_step_translation_m, rotations ±recovery_window_rotation_rad in steps of
+  // recovery_step_rotation_rad) and ICP runs again from the best one. Its result is used when it
+  // converges within the max_correction_* bounds of that pose (status kRecovered); otherwise the
+  // scan falls back to odometry as before. false: fall back at once.
+  bool recovery_search = true;
+  double recovery_window_translation_m = 0.5;
+  double recovery_window_rotation_rad = 0.7853981634;  // 45 deg
+  double recovery_step_translation_m = 0.1;
+  double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
 };
 
 /// Throws std::invalid_argument naming the first invalid field (including icp.*).
@@ -51,6 +65,7 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& config);
 enum class ScanOdometryStatus {
   kFirstScan,                   // defines the world frame (= odometry frame at the first scan)
   kRegistered,                  // ICP converged and was accepted
+  kRecovered,                   // ICP failed from the prediction, converged from a searched pose
   kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
   kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
   kFallbackTooFewPoints,        // scan or map too small for ICP: odometry used
@@ -67,7 +82,7 @@ struct ScanOdometryResult {
   Pose2 T_world_laser;                      // T_world_robot * T_robot_laser
   Pose2 T_world_robot_odometry_prediction;  // the ICP initial guess, as a robot pose
   ScanOdometryStatus status = ScanOdometryStatus::kFirstScan;
-  bool converged = false;   // true for kRegistered and kFirstScan
+  bool converged = false;   // true for kRegistered, kRecovered and kFirstScan
   bool fell_back = false;   // true for every kFallback* status
   bool degenerate = false;  // ICP held a weak direction at the odometry guess
   bool keyframe = false;    // the scan was added to the local map
@@ -102,6 +117,10 @@ class ScanOdometry {
 
  private:
   void AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser, const Pose2& T_world_laser);
+  /// ICP from the best pose of the recovery search around the prediction, when it converges
+  /// close to that pose.
+  std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
+                                   const Pose2& predicted_T_world_laser) const;
 
   ScanOdometryConfig config_;
   std::size_t num_scans_ = 0;
