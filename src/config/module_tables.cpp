@@ -133,7 +133,7 @@ const ConfigFields<LoopRefinementConfig>& LoopRefinementConfigFields() {
         .Int("partner_neighbours", &C::partner_neighbours, "",
              "loop partner chosen among the matched submap and this many neighbours per side")
         .Double("min_point_overlap", &C::min_point_overlap, "",
-                "optional: drop matches with less point overlap than this (0 = off)")
+                "drop found matches with less point overlap than this (0 = off)")
         .Double("voxel_m", &C::voxel_m, "m", "submap point clouds: one point per voxel")
         .Double("min_range_m", &C::min_range_m, "m", "shortest beam in the clouds")
         .Double("max_range_m", &C::max_range_m, "m", "beams at or beyond this are not used");

@@ -25,10 +25,6 @@ void Validate(const SlamConfig& config) {
     throw std::invalid_argument("SlamConfig." + field + ": " + why);
   };
   if (config.exclude_recent_submaps < 0) fail("exclude_recent_submaps", "must be >= 0");
-  if (config.all_scan_loop_queries &&
-      config.place.query_keypoints != PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
-    fail("all_scan_loop_queries", "needs place.query_keypoints = all_scans");
-  }
   if (!(config.exclude_recent_path_m >= 0.0)) fail("exclude_recent_path_m", "must be >= 0");
   if (!(config.gate_base_m >= 0.0)) fail("gate_base_m", "must be >= 0");
   if (!(config.gate_per_path >= 0.0)) fail("gate_per_path", "must be >= 0");
@@ -54,6 +50,11 @@ OnlineSlam::OnlineSlam(const SlamConfig& config)
 
 OnlineSlam::~OnlineSlam() = default;
 
+bool OnlineSlam::QueriesWithAllScans() const {
+  return config_.all_scan_loop_queries &&
+         config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans;
+}
+
 SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
                              const std::optional<Pose2>& T_odom_robot,
                              const std::vector<Keypoint>& keypoints) {
@@ -77,8 +78,7 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
   }
   pending_points_.push_back(std::move(points));
   ScanKeypoints scan_keypoints;
-  if (config_.all_scan_loop_queries &&
-      config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+  if (QueriesWithAllScans()) {
     scan_keypoints.positions_robot.reserve(keypoints.size());
     scan_keypoints.descriptors.reserve(keypoints.size());
     for (const Keypoint& keypoint : keypoints) {
@@ -222,7 +222,7 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
       RefineAndChoosePartner(id, eligible, loop);
       stats_.seconds_loop_refinement += SecondsSince(refine_start);
       if (loop.point_overlap < config_.loop_refinement.min_point_overlap) {
-        ++stats_.loops_rejected_by_point_overlap;  // optional verification (off by default)
+        ++stats_.loops_rejected_by_point_overlap;
       } else {
         AddLoop(id, origin_path, loop);
         step.loop = static_cast<int>(loops_.size()) - 1;

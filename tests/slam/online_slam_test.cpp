@@ -37,7 +37,13 @@ double AlignedMaxError(const std::vector<Pose2>& estimate, const std::vector<Pos
 TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   const SimulatedRun run = Simulate(1.4);
   const FlirtExtractor extractor;
-  OnlineSlam slam(SimulationConfig());
+  // Stable-keypoint loop queries, whose RANSAC transforms (~18 keypoints) the refinement must
+  // improve on. All-scan queries' RANSAC transforms are already as good in this world (summed
+  // errors 0.040 m against 0.043 m refined) and are covered by
+  // LoopQueriesUseTheKeypointsOfAllScans.
+  SlamConfig config = SimulationConfig();
+  config.all_scan_loop_queries = false;
+  OnlineSlam slam(config);
   for (std::size_t i = 0; i < run.scans.size(); ++i) {
     const std::vector<Keypoint> keypoints = extractor.Extract(run.scans[i]);
     slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints);
@@ -99,20 +105,24 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   }
 }
 
-// Issue 17: with slam.all_scan_loop_queries the loop detector queries with the keypoints of all
-// the submap's scans, as `keyplace localize` does. With gamma_min 1 for stable-keypoint queries no
-// loop can pass the stable query's gamma check; the all-scan query is held to min_gamma_all_scans
-// instead.
+// Issue 17: with slam.all_scan_loop_queries (the default) the loop detector queries with the
+// keypoints of all the submap's scans, as `keyplace localize` does. With gamma_min 1 for
+// stable-keypoint queries no loop can pass the stable query's gamma check; the all-scan query is
+// held to place.min_gamma_all_scans instead.
 TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   const SimulatedRun run = Simulate(1.4);
   const FlirtExtractor extractor;
   std::vector<std::vector<Keypoint>> keypoints;
   keypoints.reserve(run.scans.size());
   for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
-  auto loops_found = [&](bool all_scan_loop_queries) {
+  auto loops_found = [&](bool all_scan_loop_queries, double min_gamma_all_scans,
+                         PlaceRecognitionConfig::QueryKeypoints query_keypoints =
+                             PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
     SlamConfig config = SimulationConfig();
     config.all_scan_loop_queries = all_scan_loop_queries;
+    config.place.query_keypoints = query_keypoints;
     config.place.min_gamma = 1.0;
+    config.place.min_gamma_all_scans = min_gamma_all_scans;
     OnlineSlam slam(config);
     for (std::size_t i = 0; i < run.scans.size(); ++i) {
       slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints[i]);
@@ -120,13 +130,12 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
     slam.Finish();
     return slam.loops().size();
   };
-  EXPECT_EQ(loops_found(false), 0U);  // the default: stable-keypoint queries
-  EXPECT_GE(loops_found(true), 1U);
-  // The switch needs all-scan query keypoints in the place configuration.
-  SlamConfig stable = SimulationConfig();
-  stable.all_scan_loop_queries = true;
-  stable.place.query_keypoints = PlaceRecognitionConfig::QueryKeypoints::kStable;
-  EXPECT_THROW(OnlineSlam{stable}, std::invalid_argument);
+  EXPECT_EQ(loops_found(false, 0.0), 0U);  // stable-keypoint queries
+  EXPECT_GE(loops_found(true, 0.0), 1U);
+  EXPECT_EQ(loops_found(true, 1.0), 0U);  // held to min_gamma_all_scans
+  // With stable place queries (the paper preset) the loop detector queries with stable ones too.
+  EXPECT_EQ(loops_found(true, 0.0, PlaceRecognitionConfig::QueryKeypoints::kStable), 0U);
+  EXPECT_TRUE(SlamConfig{}.all_scan_loop_queries);
 }
 
 TEST(OnlineSlam, RejectsInvalidConfig) {

@@ -44,11 +44,14 @@ struct SlamConfig {
   // are neighbours that overlap by construction, not loops.
   int exclude_recent_submaps = 10;
   double exclude_recent_path_m = 10.0;
-  // Query each completed submap with the keypoints of all its scans (as `keyplace localize`
-  // does; needs place.query_keypoints = all_scans, then place.min_gamma_all_scans applies) instead
-  // of its stable keypoints. Off: on FR079_r it detected 221 loops of which 41 wrong against
-  // ground truth at the localize thresholds (docs/SLAM.md, "All-scan loop queries").
-  bool all_scan_loop_queries = false;
+  // Query each completed submap with the keypoints of all its scans, as `keyplace localize`
+  // does, instead of its ~18 stable keypoints (issue 17: a building whose stable keypoints do not
+  // recur got no loop). Applies when place.query_keypoints = all_scans (the default presets; the
+  // paper preset queries with stable keypoints, and so does the loop detector then). Such a loop
+  // passes the localize thresholds (place.min_gamma_all_scans) and then the dense point overlap
+  // check loop_refinement.min_point_overlap, chosen for it on FR079_r and Intel_r (docs/SLAM.md,
+  // "All-scan loop queries").
+  bool all_scan_loop_queries = true;
 
   // --- loop acceptance: a loop is a PlaceMatch with `found` (verified, not ambiguous); it becomes
   // a graph edge when it also passes the gate: the measured T_ref_cur agrees with the current
@@ -183,6 +186,8 @@ class OnlineSlam {
   const SlamConfig& config() const { return config_; }
 
  private:
+  // Loop queries carry all-scan keypoints (all_scan_loop_queries with all-scan place queries).
+  bool QueriesWithAllScans() const;
   void CompleteSubmap(SlamStep& step);
   // Refines a found match and chooses its partner; fills the loop's transform and partner.
   void RefineAndChoosePartner(int id, std::size_t eligible, LoopClosure& loop);
