@@ -123,7 +123,7 @@ CarmenLog ReadRos1Bag(const std::string& path, const BagInputConfig& config,
       summary = VisitBagChunks(path, decoder.Topics(), visit);
     } catch (const std::invalid_argument& walk_error) {
       throw std::invalid_argument(std::string(walk_error.what()) +
-                                  "; rosbag cannot open it either: " + error.what());
+                                  "; nor can its index be read: " + error.what());
     }
   }
   CarmenLog log =
