@@ -294,5 +294,16 @@ TEST(Ros1Bag, TheFuzzersIndexOffsetInputIsRefusedNamingTheBag) {
   ExpectContains(error, "which is not where a message record starts");
 }
 
+// The fuzzer's second input: a cut bag (read by the chunk walk) whose first /scan message has a
+// ranges length of 1.9 G floats; ros::serialization resized the vector to it (7.8 GB) before
+// finding the message too short.
+TEST(Ros1Bag, TheFuzzersScanLengthInputIsRefusedNamingTheBag) {
+  const std::string path =
+      testing::SourceDir() + "/tests/fuzz/regressions/ros1_bag/laserscan-ranges-length-7.8-gb.bag";
+  ExpectContains(ErrorOf(path, {}), path +
+                                        ": topic /scan: message 1 is damaged (a string or array "
+                                        "runs past the message's end)");
+}
+
 }  // namespace
 }  // namespace keyplace
