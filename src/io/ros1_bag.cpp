@@ -65,17 +65,17 @@ class LengthCheck {
 
 // The header; angle_min ... range_max (7 float32); ranges and intensities (float32[]).
 bool Fits(const sensor_msgs::LaserScan* /*type*/, LengthCheck& check) {
-  return check.Header() && check.Skip(7 * 4) && check.Array(4) && check.Array(4);
+  return check.Header() && check.Skip(std::size_t{7} * 4) && check.Array(4) && check.Array(4);
 }
 
 // The header; child_frame_id; pose (7 float64) and its covariance (36); twist (6) and its (36).
 bool Fits(const nav_msgs::Odometry* /*type*/, LengthCheck& check) {
-  return check.Header() && check.Array(1) && check.Skip((7 + 36 + 6 + 36) * 8);
+  return check.Header() && check.Array(1) && check.Skip(std::size_t{7 + 36 + 6 + 36} * 8);
 }
 
 // TransformStamped[]: each a header, child_frame_id and a transform (7 float64).
 bool Fits(const tf2_msgs::TFMessage* /*type*/, LengthCheck& check) {
-  constexpr std::size_t kTransformBytes = 7 * 8;
+  constexpr std::size_t kTransformBytes = std::size_t{7} * 8;
   const auto count = check.Count(12 + 4 + 4 + kTransformBytes);
   if (!count) return false;
   for (std::uint32_t i = 0; i < *count; ++i) {

@@ -35,7 +35,8 @@ struct FileRecord {
 
 // Every record of the file by its start, walked from the magic to the end. Throws BagIndexError
 // when a record runs past the end of the file, has a damaged header or is a compressed chunk
-// claiming an implausible size: rosbag would allocate what these lengths say.
+// claiming an implausible size (then the chunk walk reads what is complete, allocating nothing
+// for lengths beyond the file's end).
 std::map<std::uint64_t, FileRecord> WalkFileRecords(std::ifstream& file, std::uint64_t file_bytes) {
   std::map<std::uint64_t, FileRecord> records;
   std::uint64_t offset = kRos1BagMagicBytes;
