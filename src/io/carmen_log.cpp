@@ -61,7 +61,8 @@ class LineReader {
     if (raw_end_ >= kBagMagic.size() &&
         std::memcmp(raw_.data(), kBagMagic.data(), kBagMagic.size()) == 0) {
       // A regular file never gets here (ReadCarmenLog hands it to ReadRos1Bag).
-      throw std::invalid_argument(path + ": a ROS 1 bag through a pipe or device: rosbag seeks, " +
+      throw std::invalid_argument(path +
+                                  ": a ROS 1 bag through a pipe or device: its reader seeks, " +
                                   "so give the bag as a regular file");
     }
     gzip_ = StartsWithGzipMagic();

@@ -1,7 +1,7 @@
 #pragma once
-// Internal: the messages of a ROS 1 bag as bytes, from Debian's rosbag library (the bag's index,
-// time order) or, for a bag whose index is missing (a recorder cut off), by walking its complete
-// chunks in file order.
+// Internal: the messages of a ROS 1 bag as bytes, read through the bag's index (time order) or,
+// for a bag whose index is missing (a recorder cut off), by walking its complete chunks in file
+// order.
 
 #include <cstddef>
 #include <cstdint>
@@ -27,19 +27,19 @@ struct RawBagMessage {
 
 using RawMessageVisitor = std::function<void(const RawBagMessage&)>;
 
-/// Thrown by VisitIndexedBag when rosbag cannot open the bag (no or damaged index, cut off).
+/// Thrown by VisitIndexedBag when the bag has no usable index (missing or damaged, cut off).
 struct BagIndexError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Throws BagIndexError unless every record of the bag lies within the file and every compressed
-/// chunk claims a plausible uncompressed size (chunk_limits.hpp): rosbag trusts these lengths and
-/// allocates what they say (a hostile 4-byte field made it ask for 1.1 GB).
-void CheckBagRecords(const std::string& path);
-
-/// The messages on `topics` in time order, through rosbag (after CheckBagRecords). Throws
-/// BagIndexError when the bag cannot be opened, std::invalid_argument naming the bag and topic when
-/// a chunk cannot be read (e.g. an unknown compression).
+/// The messages on `topics` in the bag's time order (that of rosbag's View), read through the
+/// bag's index by keyplace (ros1_bag_index.cpp), each chunk decompressed once. Throws
+/// BagIndexError when the bag has no usable index: a record runs past the end of the file or a
+/// compressed chunk claims an implausible size (chunk_limits.hpp), the index is not where the bag
+/// header says (missing: a recording cut off), or its records are not as long as their counts say.
+/// Throws std::invalid_argument naming the bag when an index entry points at anything but a
+/// message record of its own connection in its chunk, a chunk cannot be decompressed (e.g. an
+/// unknown compression) or the bag is encrypted.
 BagSummary VisitIndexedBag(const std::string& path, const std::set<std::string>& topics,
                            const RawMessageVisitor& visitor);
 

@@ -4,6 +4,7 @@
 #include "keyplace/io/ros1_bag.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -179,7 +180,7 @@ TEST(Ros1Bag, ABagCutBeforeItsFirstChunkEndsIsAnError) {
   const std::string cut = WriteBytes("stub.bag", ReadBytes(Fr079Bag()).substr(0, 6000));
   const std::string error = ErrorOf(cut, {});
   ExpectContains(error, cut + ": no complete chunk");
-  ExpectContains(error, "rosbag cannot open it either");
+  ExpectContains(error, "nor can its index be read: record at byte 4117: its data run past");
 }
 
 // A cut bag's chunk claiming 512 MiB uncompressed from 95 kB of bz2 is refused before anything
@@ -207,6 +208,101 @@ TEST(Ros1Bag, AnUnknownCompressionIsNamed) {
   const std::string error = ErrorOf(path, {});
   ExpectContains(error, path + ": topic /");
   ExpectContains(error, "zst");
+}
+
+// The position of the byte `at` bytes into the first index entry of the `n`th (from 0) index data
+// record of fr079.orig.bag: header fields are written in name order, "ver" last, then the data
+// length, then the entries (uint32 sec, nsec, offset in the chunk's records).
+std::size_t IndexEntryByte(const std::string& bytes, int n, std::size_t at) {
+  std::size_t op = bytes.find(std::string("op=\x04", 4));
+  for (int i = 0; i < n; ++i) op = bytes.find(std::string("op=\x04", 4), op + 1);
+  const std::size_t ver = bytes.find("ver=", op);
+  EXPECT_NE(op, std::string::npos);
+  EXPECT_EQ(ver, op + 8);  // "op=\x04", then the length of "ver=..."
+  return ver + 8 + 4 + at;
+}
+
+std::uint32_t U32At(const std::string& bytes, std::size_t at) {
+  std::uint32_t value = 0;
+  for (int i = 3; i >= 0; --i) value = value << 8 | static_cast<std::uint8_t>(bytes[at + i]);
+  return value;
+}
+
+void SetU32At(std::string& bytes, std::size_t at, std::uint32_t value) {
+  for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<char>(value >> (8 * i) & 0xFF);
+}
+
+// rosbag reads a message where the index says, without checking (the fuzzer's finding: a header
+// parsed beyond the chunk's buffer). The first index data record is /tf_static's, one entry at
+// byte 2235 of the first chunk (at byte 4117); one byte further is inside that message.
+TEST(Ros1Bag, AnIndexEntryOffTheStartOfAMessageIsRefused) {
+  std::string bytes = ReadBytes(Fr079Bag());
+  const std::size_t offset = IndexEntryByte(bytes, 0, 8);
+  ASSERT_EQ(U32At(bytes, offset), 2235u);
+  SetU32At(bytes, offset, 2236);
+  const std::string path = WriteBytes("entry-off-start.bag", bytes);
+  ExpectContains(ErrorOf(path, {}), path +
+                                        ": index entry for topic /tf_static points at byte 2236 "
+                                        "of the chunk at byte 4117, which is not where a message "
+                                        "record starts");
+}
+
+// The /tf_static entry pointed at the first /scan message (the next record's first entry).
+TEST(Ros1Bag, AnIndexEntryAtAnotherTopicsMessageIsRefused) {
+  std::string bytes = ReadBytes(Fr079Bag());
+  const std::uint32_t scan_offset = U32At(bytes, IndexEntryByte(bytes, 1, 8));
+  SetU32At(bytes, IndexEntryByte(bytes, 0, 8), scan_offset);
+  const std::string path = WriteBytes("entry-at-scan.bag", bytes);
+  ExpectContains(ErrorOf(path, {}), path + ": index entry for topic /tf_static points at byte " +
+                                        std::to_string(scan_offset) +
+                                        " of the chunk at byte 4117, a message of topic /scan");
+}
+
+// rosbag would make a ros::Time of 2^32 - 1 s and 2 s in nanoseconds, which throws a
+// std::runtime_error while it opens the bag.
+TEST(Ros1Bag, AnIndexEntryWithNanosecondsPastOneSecondIsRefused) {
+  std::string bytes = ReadBytes(Fr079Bag());
+  SetU32At(bytes, IndexEntryByte(bytes, 0, 0), 0xFFFFFFFFU);
+  SetU32At(bytes, IndexEntryByte(bytes, 0, 4), 2000000000U);
+  const std::string path = WriteBytes("entry-nsec.bag", bytes);
+  ExpectContains(ErrorOf(path, {}), path +
+                                        ": index entry for topic /tf_static has a time of "
+                                        "4294967295 s and 2000000000 ns");
+}
+
+// An index that is not where the bag header says is no index: the chunks are read without it, as
+// for a recording cut off before its index was written.
+TEST(Ros1Bag, AnIndexPositionWhereNoRecordStartsIsReadWithoutTheIndex) {
+  std::string bytes = ReadBytes(Fr079Bag());
+  const std::size_t index_pos = bytes.find("index_pos=") + 10;
+  SetU32At(bytes, index_pos, U32At(bytes, index_pos) + 1);
+  const std::string path = WriteBytes("index-pos.bag", bytes);
+  const CarmenLog log = ReadCarmenLog(path, Reading(Fr079AsLog()));
+  EXPECT_EQ(log.scans.size(), 4934u);
+  ASSERT_FALSE(log.warnings.empty());
+  ExpectContains(log.warnings.front(), path + ": the bag's index is missing or damaged");
+}
+
+// The fuzzer's input (tests/fuzz/regressions/ros1_bag/): rosbag's written bag of a /tf_static, a
+// /tf and a /scan message with an index entry pointing near the end of the chunk; rosbag read a
+// header beyond the chunk's buffer (AddressSanitizer: heap-buffer-overflow in ros::Header::parse).
+TEST(Ros1Bag, TheFuzzersIndexOffsetInputIsRefusedNamingTheBag) {
+  const std::string path = testing::SourceDir() +
+                           "/tests/fuzz/regressions/ros1_bag/rosbag-index-offset-heap-overflow.bag";
+  const std::string error = ErrorOf(path, {});
+  ExpectContains(error, path + ": index entry for topic ");
+  ExpectContains(error, "which is not where a message record starts");
+}
+
+// The fuzzer's second input: a cut bag (read by the chunk walk) whose first /scan message has a
+// ranges length of 1.9 G floats; ros::serialization resized the vector to it (7.8 GB) before
+// finding the message too short.
+TEST(Ros1Bag, TheFuzzersScanLengthInputIsRefusedNamingTheBag) {
+  const std::string path =
+      testing::SourceDir() + "/tests/fuzz/regressions/ros1_bag/laserscan-ranges-length-7.8-gb.bag";
+  ExpectContains(ErrorOf(path, {}), path +
+                                        ": topic /scan: message 1 is damaged (a string or array "
+                                        "runs past the message's end)");
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #pragma once
-// Reader for ROS 1 bags (format 2.0; uncompressed, BZ2 or LZ4 chunks) with Debian's rosbag
-// library: the scans of a sensor_msgs/LaserScan topic, each with the robot's odometry pose at its
-// stamp and the laser's pose on the robot, as the CarmenLog every command reads.
+// Reader for ROS 1 bags (format 2.0; uncompressed, BZ2 or LZ4 chunks), keyplace's own, with the
+// message headers of Debian's ROS 1 packages: the scans of a sensor_msgs/LaserScan topic, each with
+// the robot's odometry pose at its stamp and the laser's pose on the robot, as the CarmenLog every
+// command reads.
 
 #include <string>
 
@@ -13,8 +14,8 @@ namespace keyplace {
 /// Whether `path` is a regular file that starts with the ROS 1 bag magic "#ROSBAG V2.0\n".
 bool IsRos1Bag(const std::string& path);
 
-/// Reads the bag at `path` (a regular file: rosbag seeks). Per scan message on
-/// config.scan_topic, in the bag's time order:
+/// Reads the bag at `path` (a regular file: the reader seeks). Per scan message on
+/// config.scan_topic, in the bag's time order (rosbag's):
 /// - ranges and angles as the message gives them (or spread over config.scan_fov_rad); each
 ///   float32 becomes the double of its shortest decimal spelling, as a text log would give it;
 ///   beams below range_min or NaN are invalid, at or beyond range_max (or +inf) "no return";
@@ -28,8 +29,8 @@ bool IsRos1Bag(const std::string& path);
 /// A bag whose index is missing (cut off) is read up to its last complete chunk, with a warning
 /// saying what was dropped. Throws std::invalid_argument naming the bag, the topic and the
 /// problem: a missing topic (listing those the bag has), a message of the wrong type, no
-/// odometry, no laser pose, an unreadable chunk (e.g. unknown compression), a pose beyond
-/// +-max_coordinate_m.
+/// odometry, no laser pose, an unreadable chunk (e.g. unknown compression), an index entry that
+/// points elsewhere than at a message of its topic, a pose beyond +-max_coordinate_m.
 CarmenLog ReadRos1Bag(const std::string& path, const BagInputConfig& config = {},
                       double max_coordinate_m = 1e7);
 
