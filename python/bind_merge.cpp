@@ -12,16 +12,21 @@
 namespace keyplace::python {
 namespace {
 
-MergeResult MergeMapsOf(const py::object& a, const py::object& b, const py::object& config,
-                        const py::object& overrides, const py::object& progress) {
+py::object MergeMapsOf(const py::object& a, const py::object& b, const py::object& config,
+                       const py::object& overrides, const py::object& progress) {
   // `keyplace merge` acts on the answer as a robot would: the strict preset unless told otherwise.
-  const Config resolved =
-      ResolveConfig(config.is_none() ? py::str("strict") : config, overrides).config;
+  const PyConfig resolved = ResolveConfig(config.is_none() ? py::str("strict") : config, overrides);
   const GlobalMap map_a = ToMap(a);
   const GlobalMap map_b = ToMap(b);
   const MergeProgress callback = ToProgress(progress);
-  py::gil_scoped_release release;
-  return MergeMaps(map_a, map_b, resolved.place, resolved.merge, callback);
+  MergeResult result;
+  {
+    py::gil_scoped_release release;
+    result = MergeMaps(map_a, map_b, resolved.config.place, resolved.config.merge, callback);
+  }
+  py::object merged = py::cast(std::move(result));
+  merged.attr("config") = py::cast(resolved);
+  return merged;
 }
 
 void BindRecognition(py::module_& module) {
@@ -42,7 +47,10 @@ void BindRecognition(py::module_& module) {
 }
 
 void BindMergeResult(py::module_& module) {
-  py::class_<MergeResult>(module, "MergeResult", "Where map B lies in map A, and the two joined.")
+  // dynamic_attr: merge_maps sets `config`, the keyplace.Config it merged with.
+  py::class_<MergeResult>(module, "MergeResult", py::dynamic_attr(),
+                          "Where map B lies in map A, and the two joined; `config` is the "
+                          "keyplace.Config used (the CLI JSON's 'config').")
       .def_property_readonly(
           "T_a_b", [](const MergeResult& r) { return PoseArray(r.T_a_b); },
           "B's frame in A's frame [x_m, y_m, theta_rad]: a point p_b of B is T_a_b * p_b in A; "

@@ -19,6 +19,7 @@ namespace {
 
 // One benchmark run: what it was run on, its options, records and summary.
 struct PyRelocalization {
+  PyConfig config;  // the whole configuration of the run
   std::size_t first_scan = 0;
   std::size_t end_scan = 0;
   PoseSource pose_source = PoseSource::kCorrected;
@@ -40,8 +41,9 @@ PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
                             const std::string& self_match, bool skip_bad_lines,
                             const py::object& progress) {
   // `keyplace relocalize`: a robot acts on a fix, so the strict preset unless told otherwise.
-  const Config resolved =
-      ResolveConfig(config.is_none() ? py::str("strict") : config, overrides).config;
+  const PyConfig resolved_config =
+      ResolveConfig(config.is_none() ? py::str("strict") : config, overrides);
+  const Config& resolved = resolved_config.config;
   if (self_match != "shared-scan" && self_match != "none") {
     throw py::value_error("self_match is '" + self_match + "': 'shared-scan' or 'none'");
   }
@@ -66,6 +68,7 @@ PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
   const GroundTruth ground_truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
                                                    truth_path, index_path, inputs.source_hash);
   PyRelocalization run;
+  run.config = resolved_config;
   run.first_scan = inputs.first_scan;
   run.end_scan = inputs.first_scan + inputs.log.scans.size();
   run.pose_source = inputs.pose_source;
@@ -162,7 +165,9 @@ void BindRelocalizationEvaluation(py::module_& module) {
   Summary(cls, "lost_signals", &S::lost_signals, "");
   Summary(cls, "lost_on_correct_track", &S::lost_on_correct_track, "");
   Summary(cls, "lost_on_wrong_track", &S::lost_on_wrong_track, "");
-  cls.def_readonly("keypoint_seconds_per_scan", &PyRelocalization::keypoint_seconds_per_scan)
+  cls.def_readonly("config", &PyRelocalization::config,
+                   "The keyplace.Config of the run (the CLI's JSON 'config').")
+      .def_readonly("keypoint_seconds_per_scan", &PyRelocalization::keypoint_seconds_per_scan)
       .def_readonly("query_log_is_map_log", &PyRelocalization::query_log_is_map_log)
       .def_property_readonly(
           "scans",

@@ -9,7 +9,7 @@ import unittest
 import numpy as np
 
 import keyplace
-from support import BUNDLED_LOG, run_cli
+from support import BUNDLED_LOG, flat_config, run_cli
 
 SPLIT = 732  # the middle of the bundled log
 
@@ -47,6 +47,9 @@ class MergeTest(unittest.TestCase):
         self.assertGreaterEqual(self.result.agreeing, 3)
         self.assertEqual(self.result.merged.submap_count, self.cli["submaps_merged"])
         self.assertEqual(len(self.result.recognitions), len(self.cli["recognitions"]))
+        # The same configuration, the CLI's default preset (strict) included.
+        self.assertEqual(self.result.config.to_dict(), flat_config(self.cli["config"]))
+        self.assertEqual(self.result.config.preset, "strict")
         for mine, theirs in zip(self.result.recognitions, self.cli["recognitions"]):
             self.assertEqual((mine.submap_b, mine.submap_a, mine.agrees),
                              (theirs["submap_b"], theirs["submap_a"], theirs["agrees"]))

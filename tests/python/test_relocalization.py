@@ -9,7 +9,7 @@ import unittest
 import numpy as np
 
 import keyplace
-from support import run_cli, write_log_part
+from support import flat_config, run_cli, write_log_part
 
 SCANS = 600
 STARTS = 6
@@ -62,6 +62,9 @@ class RelocalizationTest(unittest.TestCase):
             self.assertEqual(getattr(evaluation, key), cli[key], key)
         self.assertEqual(list(evaluation.scans), cli["scans"])
         self.assertEqual(len(evaluation.records), evaluation.starts)
+        # The same configuration: the CLI's preset (strict) and settings, key by key.
+        self.assertEqual(evaluation.config.to_dict(), flat_config(cli["config"]))
+        self.assertEqual(evaluation.config.get("place.min_reference_coverage"), "0.5")
 
     def test_own_log_without_the_shared_scan_rule(self):
         cli, text, fixes_path, evaluation = self.run_both("none", "--self-match", "none",
