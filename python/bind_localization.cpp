@@ -10,18 +10,9 @@
 #include "bindings.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/localization/relocalizer.hpp"
-#include "keyplace/store/map_file.hpp"
 
 namespace keyplace::python {
 namespace {
-
-// A map argument: a keyplace.Map or the path of a map file.
-GlobalMap ToMap(const py::object& map) {
-  if (py::isinstance<GlobalMap>(map)) return map.cast<const GlobalMap&>();
-  const std::string path = py::str(map).cast<std::string>();
-  py::gil_scoped_release release;
-  return LoadMap(path);
-}
 
 template <typename Localizer>
 Localizer MakeLocalizer(const py::object& map, const py::object& config,

@@ -3,7 +3,9 @@
 // conversions between the library's types and numpy arrays (docs/PYTHON.md).
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "keyplace/config/config.hpp"
 #include "keyplace/features/descriptor.hpp"
 #include "keyplace/io/laser_scan.hpp"
+#include "keyplace/mapping/global_map.hpp"
 
 namespace keyplace::python {
 
@@ -27,6 +30,9 @@ void BindFeatures(py::module_& module);
 void BindMapping(py::module_& module);
 void BindLocalization(py::module_& module);
 void BindEvaluation(py::module_& module);
+void BindMerge(py::module_& module);
+void BindNavigation(py::module_& module);  // after BindLocalization: extends RelocalizationUpdate
+void BindRelocalization(py::module_& module);
 
 /// The configuration of keyplace.Config: the library's Config and the preset it started from
 /// (the preset decides defaults such as localize's rank_by, as in the CLI).
@@ -38,6 +44,14 @@ struct PyConfig {
 /// The configuration a function was given: `config` (None, a preset name or a keyplace.Config),
 /// then `overrides` (None or a dict of "section.key" -> value, like --set).
 PyConfig ResolveConfig(const py::object& config, const py::object& overrides);
+
+/// A map argument: a keyplace.Map (copied) or the path of a map file (read without the GIL).
+GlobalMap ToMap(const py::object& map);
+
+/// A progress argument: None (no callback), or a callable progress(done, total) the library calls
+/// from whatever thread it works on; the GIL is taken for each call, and an exception the
+/// callable raises ends the work and reaches the caller.
+std::function<void(std::size_t, std::size_t)> ToProgress(const py::object& progress);
 
 /// [x, y, theta] (m, m, rad).
 py::array_t<double> PoseArray(const Pose2& pose);

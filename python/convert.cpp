@@ -1,6 +1,7 @@
 // Conversions between the library's types and numpy arrays, and configuration from Python.
 
 #include <algorithm>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "bindings.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/store/map_file.hpp"
 
 namespace keyplace::python {
 namespace {
@@ -50,6 +52,31 @@ PyConfig ResolveConfig(const py::object& config, const py::object& overrides) {
     SetConfigValue(py::str(key).cast<std::string>(), ConfigText(value), resolved.config);
   }
   return resolved;
+}
+
+GlobalMap ToMap(const py::object& map) {
+  if (py::isinstance<GlobalMap>(map)) return map.cast<const GlobalMap&>();
+  const std::string path = py::str(map).cast<std::string>();
+  py::gil_scoped_release release;
+  return LoadMap(path);
+}
+
+std::function<void(std::size_t, std::size_t)> ToProgress(const py::object& progress) {
+  if (progress.is_none()) return {};
+  if (!PyCallable_Check(progress.ptr())) {
+    throw py::type_error("progress must be None or a callable progress(done, total)");
+  }
+  // The library copies and drops its callbacks on worker threads without the GIL: the callable
+  // is held through a shared pointer whose copies leave its reference count alone, and the last
+  // owner takes the GIL to release it.
+  const std::shared_ptr<py::object> callable(new py::object(progress), [](py::object* object) {
+    const py::gil_scoped_acquire acquire;
+    delete object;
+  });
+  return [callable](std::size_t done, std::size_t total) {
+    const py::gil_scoped_acquire acquire;
+    (*callable)(done, total);
+  };
 }
 
 py::array_t<double> PoseArray(const Pose2& pose) {

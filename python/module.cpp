@@ -15,4 +15,7 @@ PYBIND11_MODULE(keyplace, module) {
   keyplace::python::BindMapping(module);
   keyplace::python::BindLocalization(module);
   keyplace::python::BindEvaluation(module);
+  keyplace::python::BindMerge(module);
+  keyplace::python::BindNavigation(module);
+  keyplace::python::BindRelocalization(module);
 }

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,37 +37,17 @@ struct RelocalizeOptions {
   int starts = 50;
 };
 
-RelocalizationOptions BenchmarkOptions(const RelocalizeOptions& o, const Config& config,
-                                       bool query_log_is_map_log) {
-  RelocalizationOptions options;
-  options.starts = o.starts;
-  options.give_up_m = config.evaluation.give_up_m;
-  options.follow_m = config.evaluation.follow_m;
-  options.revisit_m = config.evaluation.revisit_radius_m;
-  options.revisit_deg = config.evaluation.revisit_angle_deg;
-  options.truth_max_gap_scans = config.evaluation.truth_max_gap_scans;
-  // Scan indices of another recording say nothing about this one: no self-match rule there.
-  options.exclude_shared_scans = o.self_match == "shared-scan" && query_log_is_map_log;
-  return options;
-}
-
 // The first fix of the first start that got one, as the /initialpose message a robot would
 // publish at that moment; a note when no start got a fix (nothing is written).
 void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
-  for (const StartRecord& record : report.records) {
-    for (const FixEvent& fix : record.fixes) {
-      if (!fix.first) continue;
-      InitialPose pose;
-      pose.T_map_robot = fix.T_world_robot_at_fix;
-      pose.position_variance_m2 = fix.position_variance_m2;
-      pose.heading_variance_rad2 = fix.heading_variance_rad2;
-      WriteInitialPose(pose, path);
-      fmt::print("initial pose (first fix, start at scan {}, fix at scan {}) written to {}\n",
-                 record.start_scan, fix.scan, path);
-      return;
-    }
+  const std::optional<FirstFix> first = FirstFixOf(report.records);
+  if (!first) {
+    fmt::print(stderr, "keyplace: note: no start got a fix; {} not written\n", path);
+    return;
   }
-  fmt::print(stderr, "keyplace: note: no start got a fix; {} not written\n", path);
+  WriteInitialPose(InitialPoseOf(first->fix), path);
+  fmt::print("initial pose (first fix, start at scan {}, fix at scan {}) written to {}\n",
+             first->start_scan, first->fix.scan, path);
 }
 
 void RunRelocalize(const RelocalizeOptions& options) {
@@ -97,7 +78,9 @@ void RunRelocalize(const RelocalizeOptions& options) {
       options.map_path, map,
       options.query.truth_path.empty() ? options.query.log_path : options.query.truth_path,
       report.query_log_is_map_log);
-  report.options = BenchmarkOptions(options, config, report.query_log_is_map_log);
+  report.options =
+      RelocalizationOptionsFor(config.evaluation, options.starts,
+                               options.self_match == "shared-scan", report.query_log_is_map_log);
   report.seconds_keypoints_per_scan =
       inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());
 

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -290,6 +292,41 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   s.distance_after_revisit_p90_m = Quantile(after_revisit, 0.9);
   if (updates > 0) s.update_seconds_mean = seconds_sum / static_cast<double>(updates);
   return s;
+}
+
+RelocalizationOptions RelocalizationOptionsFor(const EvaluationConfig& evaluation, int starts,
+                                               bool shared_scan_rule, bool query_log_is_map_log) {
+  if (starts < 1) {
+    throw std::invalid_argument("relocalization: starts is " + std::to_string(starts) +
+                                ", must be >= 1");
+  }
+  RelocalizationOptions options;
+  options.starts = starts;
+  options.give_up_m = evaluation.give_up_m;
+  options.follow_m = evaluation.follow_m;
+  options.revisit_m = evaluation.revisit_radius_m;
+  options.revisit_deg = evaluation.revisit_angle_deg;
+  options.truth_max_gap_scans = evaluation.truth_max_gap_scans;
+  options.exclude_shared_scans = shared_scan_rule && query_log_is_map_log;
+  return options;
+}
+
+std::optional<FirstFix> FirstFixOf(const std::vector<StartRecord>& records) {
+  for (const StartRecord& record : records) {
+    for (const FixEvent& fix : record.fixes) {
+      if (fix.first) return FirstFix{record.start_scan, fix};
+    }
+  }
+  return std::nullopt;
+}
+
+InitialPose InitialPoseOf(const FixEvent& fix, const std::string& frame_id) {
+  InitialPose pose;
+  pose.frame_id = frame_id;
+  pose.T_map_robot = fix.T_world_robot_at_fix;
+  pose.position_variance_m2 = fix.position_variance_m2;
+  pose.heading_variance_rad2 = fix.heading_variance_rad2;
+  return pose;
 }
 
 }  // namespace keyplace

@@ -13,18 +13,6 @@
 namespace keyplace {
 namespace {
 
-constexpr std::size_t kX = 0;
-constexpr std::size_t kY = 7;
-constexpr std::size_t kYaw = 35;
-
-std::array<double, 36> Covariance(const InitialPose& pose) {
-  std::array<double, 36> covariance{};
-  covariance[kX] = pose.position_variance_m2;
-  covariance[kY] = pose.position_variance_m2;
-  covariance[kYaw] = pose.heading_variance_rad2;
-  return covariance;
-}
-
 bool EndsWith(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() &&
          text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -51,7 +39,7 @@ std::string MessageText(const InitialPose& pose, bool json) {
   };
   const double half_rad = 0.5 * pose.T_map_robot.theta;
   std::string covariance;
-  for (const double value : Covariance(pose)) {
+  for (const double value : InitialPoseCovariance(pose)) {
     covariance += (covariance.empty() ? "" : ", ") + FormatConfigDouble(value);
   }
   const std::string frame = json ? "\"" + pose.frame_id + "\"" : pose.frame_id;
@@ -66,6 +54,17 @@ std::string MessageText(const InitialPose& pose, bool json) {
 }
 
 }  // namespace
+
+std::array<double, 36> InitialPoseCovariance(const InitialPose& pose) {
+  constexpr std::size_t kX = 0;  // row-major indices of the x, y and yaw diagonal terms
+  constexpr std::size_t kY = 7;
+  constexpr std::size_t kYaw = 35;
+  std::array<double, 36> covariance{};
+  covariance[kX] = pose.position_variance_m2;
+  covariance[kY] = pose.position_variance_m2;
+  covariance[kYaw] = pose.heading_variance_rad2;
+  return covariance;
+}
 
 InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string& frame_id) {
   if (update.status != FixStatus::kFixed) {

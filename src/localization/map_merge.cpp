@@ -21,16 +21,21 @@ struct Candidate {
 };
 
 std::vector<Candidate> RecogniseSubmaps(const GlobalMap& a, const GlobalMap& b,
-                                        const PlaceRecognitionConfig& place, std::size_t& queried) {
+                                        const PlaceRecognitionConfig& place,
+                                        const MergeProgress& progress, std::size_t& queried) {
   const PlaceRecognizer recognizer(PlacesFromMap(a), place);
+  const std::vector<Place> b_places = PlacesFromMap(b);
+  const auto to_query = static_cast<std::size_t>(std::count_if(
+      b_places.begin(), b_places.end(), [](const Place& p) { return !p.positions.empty(); }));
   std::vector<Candidate> candidates;
-  for (const Place& query_place : PlacesFromMap(b)) {
+  for (const Place& query_place : b_places) {
     if (query_place.positions.empty()) continue;
     ++queried;
     PlaceQuery query;
     query.positions = query_place.positions;
     query.descriptors = query_place.descriptors;
     const PlaceMatch match = recognizer.Recognize(query);
+    if (progress) progress(queried, to_query);
     if (!match.found) continue;
     const Place& matched = recognizer.places()[static_cast<std::size_t>(match.place_index)];
     // A's submap origin * (B submap origin in its frame) = B submap origin in A's frame.
@@ -121,7 +126,7 @@ GlobalMap MovedMap(const GlobalMap& map, const Pose2& T_new_old) {
 }
 
 MergeResult MergeMaps(const GlobalMap& a, const GlobalMap& b, const PlaceRecognitionConfig& place,
-                      const MergeOptions& options) {
+                      const MergeOptions& options, const MergeProgress& progress) {
   Validate(options);
   const auto settings_a = ToKeyValues(a.config);
   const auto settings_b = ToKeyValues(b.config);
@@ -134,7 +139,7 @@ MergeResult MergeMaps(const GlobalMap& a, const GlobalMap& b, const PlaceRecogni
     }
   }
   MergeResult result;
-  std::vector<Candidate> candidates = RecogniseSubmaps(a, b, place, result.queried);
+  std::vector<Candidate> candidates = RecogniseSubmaps(a, b, place, progress, result.queried);
   const std::vector<std::size_t> group = LargestAgreeingGroup(candidates, options);
   if (static_cast<int>(group.size()) < options.min_agreeing) {
     throw std::invalid_argument(

@@ -43,17 +43,12 @@ std::uint8_t PixelOf(CellState state) {
 
 void WriteImage(const OccupancyGrid& grid, const OccupancyGridConfig& config,
                 const std::string& path) {
-  std::vector<char> pixels;
-  pixels.reserve(static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height));
-  for (int row = grid.height - 1; row >= 0; --row) {  // the image's first row is the top
-    for (int column = 0; column < grid.width; ++column) {
-      pixels.push_back(static_cast<char>(PixelOf(grid.State(column, row, config))));
-    }
-  }
+  const std::vector<std::uint8_t> pixels = MapServerImage(grid, config);
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "P5\n# keyplace occupancy grid, " << grid.resolution_m << " m per pixel\n"
         << grid.width << ' ' << grid.height << "\n255\n";
-    out.write(pixels.data(), static_cast<std::streamsize>(pixels.size()));
+    out.write(reinterpret_cast<const char*>(pixels.data()),
+              static_cast<std::streamsize>(pixels.size()));
   });
 }
 
@@ -124,6 +119,18 @@ Value Required(const YAML::Node& root, const char* key, const std::string& path)
 }
 
 }  // namespace
+
+std::vector<std::uint8_t> MapServerImage(const OccupancyGrid& grid,
+                                         const OccupancyGridConfig& config) {
+  std::vector<std::uint8_t> pixels;
+  pixels.reserve(static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height));
+  for (int row = grid.height - 1; row >= 0; --row) {  // the image's first row is the top
+    for (int column = 0; column < grid.width; ++column) {
+      pixels.push_back(PixelOf(grid.State(column, row, config)));
+    }
+  }
+  return pixels;
+}
 
 std::string MapServerImagePath(const std::string& yaml_path) {
   return std::filesystem::path(yaml_path).replace_extension(".pgm").string();

@@ -17,6 +17,7 @@ check "map first half" "$keyplace" map "$log" --scans 0:732 --start-at-origin --
 check "map second half" "$keyplace" map "$log" --scans 732: --start-at-origin --out "$work/b.kpm"
 check "merge" "$keyplace" merge "$work/a.kpm" "$work/b.kpm" --out "$work/ab.kpm" \
   --json "$work/merge.json"
+cp "$work/err" "$work/merge.err"
 # Truth: B's frame is the corrected pose of scan 732 seen from that of scan 0 (A's frame).
 check "transform against the corrected poses" python3 -c "
 import gzip, json, math, sys
@@ -38,6 +39,19 @@ assert error_m < 0.1 and error_deg < 0.5, (T, truth)
 assert j['agreeing'] >= 3 and j['agreeing'] <= j['recognised'] <= j['submaps_queried'], j
 assert sum(r['agrees'] for r in j['recognitions']) == j['agreeing'], j
 " "$log" "$work/merge.json"
+check "merge --help mentions the progress line" grep -q "KEYPLACE_PROGRESS" <("$keyplace" merge --help)
+# Progress: none on stderr when it is not a terminal (KEYPLACE_PROGRESS=0 above stands for that);
+# with KEYPLACE_PROGRESS=1 the line of the other commands, counting B's submaps, ending with all
+# of them done.
+check "merge quiet" test ! -s "$work/merge.err"
+KEYPLACE_PROGRESS=1 "$keyplace" merge "$work/a.kpm" "$work/b.kpm" --out "$work/ab2.kpm" \
+  >/dev/null 2>"$work/progress.err"
+check "merge progress line" python3 -c "
+import json, re, sys
+text = open(sys.argv[1]).read()
+queried = json.load(open(sys.argv[2]))['submaps_queried']
+assert re.search(r'submaps of B  %d/%d  done in [0-9.]+ s' % (queried, queried), text), text
+" "$work/progress.err" "$work/merge.json"
 check "merged map readable" "$keyplace" info "$work/ab.kpm" --json "$work/ab.json"
 check "merged map holds both" python3 -c "
 import json, sys

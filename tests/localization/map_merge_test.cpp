@@ -2,9 +2,11 @@
 // found in the first half's map, and two different buildings are refused.
 
 #include <cmath>
+#include <cstddef>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -39,7 +41,14 @@ TEST(MapMerge, TheSecondHalfInAFrameOfItsOwnIsFoundInTheFirst) {
   const GlobalMap b_world = Half(false);
   const Pose2 T_world_b = b_world.submaps.front().origin();
   const GlobalMap b = MovedMap(b_world, T_world_b.inverse());
-  const MergeResult result = MergeMaps(a, b, Strict());
+  std::vector<std::size_t> done;
+  const MergeResult result = MergeMaps(a, b, Strict(), {}, [&](std::size_t d, std::size_t total) {
+    EXPECT_EQ(total, b.submaps.size());
+    done.push_back(d);
+  });
+  // Progress after each B submap recognised, counting up to all of them.
+  ASSERT_EQ(done.size(), b.submaps.size());
+  for (std::size_t k = 0; k < done.size(); ++k) EXPECT_EQ(done[k], k + 1);
   // A is in the world frame, so B's frame in A's is T_world_b.
   const Pose2 error = Between(T_world_b, result.T_a_b);
   EXPECT_LT(std::hypot(error.x, error.y), 0.1) << error.x << " " << error.y;

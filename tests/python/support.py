@@ -38,3 +38,12 @@ def write_log_part(folder, scans):
     with gzip.open(BUNDLED_LOG, "rt") as source, open(path, "w") as part:
         part.writelines(line for _, line in zip(range(2 * scans), source))
     return path
+
+
+def flat_config(node, prefix=""):
+    """The `config` of a CLI JSON (nested sections, text values) as Config.to_dict() gives it:
+    {"section.key": text}."""
+    if not isinstance(node, dict):
+        return {prefix[:-1]: node}
+    return {key: value for name, child in node.items()
+            for key, value in flat_config(child, prefix + name + ".").items()}

@@ -7,11 +7,15 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/localization/initial_pose.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 
@@ -33,6 +37,14 @@ struct RelocalizationOptions {
   // (evaluation.truth_max_gap_scans); fixes with none are not counted.
   int truth_max_gap_scans = 50;
 };
+
+/// The benchmark's options for `starts` starts from the evaluation settings (give_up_m, follow_m,
+/// the revisit radius and angle, truth_max_gap_scans), as `keyplace relocalize` runs it: map
+/// submaps sharing a scan with the query are skipped when `shared_scan_rule` is asked for and
+/// the query log is the map's own (a scan index of another recording says nothing about this
+/// one). Throws std::invalid_argument when starts < 1.
+RelocalizationOptions RelocalizationOptionsFor(const EvaluationConfig& evaluation, int starts,
+                                               bool shared_scan_rule, bool query_log_is_map_log);
 
 /// One fix the relocalizer reported (at an update where a query was answered).
 struct FixEvent {
@@ -115,5 +127,17 @@ std::vector<StartRecord> RunRelocalization(const GlobalMap& map, const LogInputs
 
 RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& records,
                                               const RelocalizationOptions& options);
+
+/// The first fix of the first start that got one: what a robot would publish on /initialpose.
+struct FirstFix {
+  int start_scan = 0;  // the start (StartRecord::start_scan)
+  FixEvent fix;
+};
+/// Nothing when no start got a fix.
+std::optional<FirstFix> FirstFixOf(const std::vector<StartRecord>& records);
+
+/// A fix as the /initialpose message: the robot's pose and the variances as reported at the fix
+/// (FixEvent::T_world_robot_at_fix, position_variance_m2, heading_variance_rad2).
+InitialPose InitialPoseOf(const FixEvent& fix, const std::string& frame_id = "map");
 
 }  // namespace keyplace

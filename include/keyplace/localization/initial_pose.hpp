@@ -3,6 +3,7 @@
 // AMCL or nav2 (docs/NAVIGATION.md): `rostopic pub -f fix.yaml /initialpose
 // geometry_msgs/PoseWithCovarianceStamped`, or the same fields in JSON.
 
+#include <array>
 #include <string>
 
 #include "keyplace/common/pose2.hpp"
@@ -20,6 +21,10 @@ struct InitialPose {
 /// The fix of an update whose status is kFixed (std::invalid_argument otherwise), with the
 /// filter's variances.
 InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string& frame_id = "map");
+
+/// The message's 6x6 covariance, row-major over x, y, z, roll, pitch, yaw: the position variance
+/// on the x and y diagonal terms, the heading variance on the yaw one, 0 elsewhere.
+std::array<double, 36> InitialPoseCovariance(const InitialPose& pose);
 
 /// The message as YAML (header without stamp: a zero stamp means "now" to AMCL, and leaving it
 /// out keeps the text valid for ROS 1's secs/nsecs and ROS 2's sec/nanosec alike). The 6x6

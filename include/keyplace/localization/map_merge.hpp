@@ -3,6 +3,7 @@
 // recognising B's submaps in A, and the two joined into one map in A's frame (docs/MERGE.md).
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
@@ -40,6 +41,9 @@ struct MergeResult {
   std::size_t agreeing = 0;
 };
 
+/// Progress: (B submaps recognised, B submaps to recognise: those with keypoints), after each.
+using MergeProgress = std::function<void(std::size_t, std::size_t)>;
+
 /// Recognises every submap of B in A with `place`, takes the largest group of recognitions that
 /// agree on B's frame, fits T_a_b to it (mean heading, then the least-squares translation of the
 /// group's B submap origins) and joins the maps: B's ids start at the second thousand after A's
@@ -49,7 +53,7 @@ struct MergeResult {
 /// different mapping settings, or when fewer than options.min_agreeing recognitions agree (no
 /// reliable overlap: saying how many were found and how many agreed).
 MergeResult MergeMaps(const GlobalMap& a, const GlobalMap& b, const PlaceRecognitionConfig& place,
-                      const MergeOptions& options = {});
+                      const MergeOptions& options = {}, const MergeProgress& progress = {});
 
 /// `map` moved rigidly: every pose P becomes T_new_old * P (keypoints and occupancy stay in their
 /// submap frames).

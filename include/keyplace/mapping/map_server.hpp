@@ -23,6 +23,12 @@ inline constexpr std::uint8_t kMapServerUnknown = 205;
 inline constexpr double kMapServerOccupiedThresh = 0.65;
 inline constexpr double kMapServerFreeThresh = 0.196;
 
+/// The trinary image of the grid as the PGM holds it: width x height pixels, row-major, the top
+/// (largest y) row first, each kMapServerOccupied, kMapServerFree or kMapServerUnknown by the
+/// grid's state under `config`'s thresholds.
+std::vector<std::uint8_t> MapServerImage(const OccupancyGrid& grid,
+                                         const OccupancyGridConfig& config);
+
 /// The image file of a map_server YAML path: the same path with the extension ".pgm".
 std::string MapServerImagePath(const std::string& yaml_path);
 

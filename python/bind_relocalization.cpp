@@ -1,0 +1,228 @@
+// The kidnapped-robot benchmark of `keyplace relocalize` (eval/relocalization.hpp): its records per
+// start and fix, its summary figures (the keys of `keyplace relocalize --json`) and its first fix
+// as the /initialpose message.
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/eval/relocalization.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
+
+namespace keyplace::python {
+namespace {
+
+// One benchmark run: what it was run on, its options, records and summary.
+struct PyRelocalization {
+  PyConfig config;  // the whole configuration of the run
+  std::size_t first_scan = 0;
+  std::size_t end_scan = 0;
+  PoseSource pose_source = PoseSource::kCorrected;
+  bool query_log_is_map_log = false;
+  RelocalizationOptions options;
+  std::vector<StartRecord> records;
+  RelocalizationSummary summary;
+  double keypoint_seconds_per_scan = 0.0;
+};
+
+std::string TextOrEmpty(const py::object& value) {
+  return value.is_none() ? std::string() : py::str(value).cast<std::string>();
+}
+
+PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
+                            const py::object& config, const py::object& overrides,
+                            const std::string& poses, const py::object& truth,
+                            const py::object& index, const py::object& scans, int starts,
+                            const std::string& self_match, bool skip_bad_lines,
+                            const py::object& progress) {
+  // `keyplace relocalize`: a robot acts on a fix, so the strict preset unless told otherwise.
+  const PyConfig resolved_config =
+      ResolveConfig(config.is_none() ? py::str("strict") : config, overrides);
+  const Config& resolved = resolved_config.config;
+  if (self_match != "shared-scan" && self_match != "none") {
+    throw py::value_error("self_match is '" + self_match + "': 'shared-scan' or 'none'");
+  }
+  LogInputOptions input_options;
+  input_options.reading.bag = resolved.input;
+  input_options.reading.skip_bad_lines = skip_bad_lines;
+  input_options.poses = ParsePoseSource(poses);
+  input_options.odometry = resolved.odometry;
+  input_options.features = resolved.features;
+  if (!scans.is_none()) {
+    const auto range = scans.cast<std::pair<std::size_t, std::size_t>>();
+    input_options.first_scan = range.first;
+    input_options.end_scan = range.second;
+  }
+  const std::string truth_path = TextOrEmpty(truth);
+  const std::string index_path = TextOrEmpty(index);
+  const GlobalMap global_map = ToMap(map);
+  const StartProgress callback = ToProgress(progress);
+
+  py::gil_scoped_release release;
+  const LogInputs inputs = PrepareLogInputs(log_path, input_options);
+  const GroundTruth ground_truth = LoadGroundTruth(inputs.log, inputs.first_scan, inputs.file_scans,
+                                                   truth_path, index_path, inputs.source_hash);
+  PyRelocalization run;
+  run.config = resolved_config;
+  run.first_scan = inputs.first_scan;
+  run.end_scan = inputs.first_scan + inputs.log.scans.size();
+  run.pose_source = inputs.pose_source;
+  run.query_log_is_map_log = TruthIsMapLog(global_map, ground_truth);
+  run.options = RelocalizationOptionsFor(resolved.evaluation, starts, self_match == "shared-scan",
+                                         run.query_log_is_map_log);
+  run.keypoint_seconds_per_scan =
+      inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());
+  run.records = RunRelocalization(global_map, inputs, ground_truth, ToLocalizerConfig(resolved),
+                                  run.options, callback);
+  run.summary = SummarizeRelocalization(run.records, run.options);
+  return run;
+}
+
+void BindRecords(py::module_& module) {
+  py::class_<FixEvent>(module, "FixEvent", "One fix the relocalizer reported, checked.")
+      .def_readonly("scan", &FixEvent::scan, "Query-log scan it was reported at.")
+      .def_readonly("checked_scan", &FixEvent::checked_scan,
+                    "The scan it was checked at (the nearest with a truth pose).")
+      .def_property_readonly(
+          "pose", [](const FixEvent& f) { return PoseArray(f.T_world_robot); },
+          "T_world_robot (map frame) at checked_scan.")
+      .def_property_readonly(
+          "truth", [](const FixEvent& f) { return PoseArray(f.truth); },
+          "True T_world_robot at checked_scan.")
+      .def_property_readonly(
+          "pose_at_fix", [](const FixEvent& f) { return PoseArray(f.T_world_robot_at_fix); },
+          "T_world_robot as reported at `scan` (what a robot publishes).")
+      .def_readonly("confidence", &FixEvent::confidence)
+      .def_readonly("position_variance_m2", &FixEvent::position_variance_m2)
+      .def_readonly("heading_variance_rad2", &FixEvent::heading_variance_rad2)
+      .def_readonly("correct", &FixEvent::correct, "Within 0.5 m and 10 deg of the truth.")
+      .def_readonly("first", &FixEvent::first, "The start's first fix.")
+      .def(
+          "initial_pose",
+          [](const FixEvent& f, const std::string& frame_id) { return InitialPoseOf(f, frame_id); },
+          py::arg("frame_id") = "map", "The fix as the /initialpose message (InitialPose).");
+
+  py::class_<StartRecord>(module, "StartRecord", "One start of the benchmark.")
+      .def_readonly("start_scan", &StartRecord::start_scan)
+      .def_readonly("end_scan", &StartRecord::end_scan, "One past the last scan fed.")
+      .def_readonly("revisit", &StartRecord::revisit,
+                    "Its path before the cap passes a map scan the localizer may match.")
+      .def_readonly("distance_to_revisit_m", &StartRecord::distance_to_revisit_m)
+      .def_readonly("fixed", &StartRecord::fixed)
+      .def_readonly("scans_to_fix", &StartRecord::scans_to_fix)
+      .def_readonly("distance_to_fix_m", &StartRecord::distance_to_fix_m)
+      .def_readonly("first_fix_checked", &StartRecord::first_fix_checked)
+      .def_readonly("first_fix_correct", &StartRecord::first_fix_correct)
+      .def_readonly("answers", &StartRecord::answers)
+      .def_readonly("answers_accepted", &StartRecord::answers_accepted)
+      .def_readonly("fixes", &StartRecord::fixes, "The fixes reported (list of FixEvent).")
+      .def_readonly("wrong_fixes", &StartRecord::wrong_fixes)
+      .def_readonly("lost", &StartRecord::lost, "'lost' signals.")
+      .def_readonly("lost_on_correct_track", &StartRecord::lost_on_correct_track)
+      .def_readonly("lost_on_wrong_track", &StartRecord::lost_on_wrong_track)
+      .def_readonly("update_seconds_mean", &StartRecord::update_seconds_mean)
+      .def_readonly("update_seconds_max", &StartRecord::update_seconds_max);
+}
+
+// A summary figure as a read-only property named as its key in `keyplace relocalize --json`.
+template <typename Field>
+void Summary(py::class_<PyRelocalization>& cls, const char* name, Field field, const char* doc) {
+  cls.def_property_readonly(
+      name, [field](const PyRelocalization& r) { return r.summary.*field; }, doc);
+}
+
+void BindRelocalizationEvaluation(py::module_& module) {
+  py::class_<PyRelocalization> cls(
+      module, "RelocalizationEvaluation",
+      "What `keyplace relocalize` measures: the summary figures (named as in its --json), one "
+      "StartRecord per start, and the first fix.");
+  using S = RelocalizationSummary;
+  Summary(cls, "starts", &S::starts, "Starts run (capped to the scans with a truth pose).");
+  Summary(cls, "starts_with_revisit", &S::starts_with_revisit, "");
+  Summary(cls, "fixed", &S::fixed, "Starts with a first fix.");
+  Summary(cls, "fixed_with_revisit", &S::fixed_with_revisit, "");
+  Summary(cls, "fixed_fraction", &S::fixed_fraction, "fixed_with_revisit / starts_with_revisit.");
+  Summary(cls, "fixes", &S::fixes, "Fixes reported and checked.");
+  Summary(cls, "wrong_fixes", &S::wrong_fixes, "");
+  Summary(cls, "wrong_fix_rate", &S::wrong_fix_rate, "wrong_fixes / fixes.");
+  Summary(cls, "wrong_first_fixes", &S::wrong_first_fixes, "");
+  Summary(cls, "wrong_fix_confident", &S::wrong_fix_confident,
+          "A wrong fix had confidence >= 0.9.");
+  Summary(cls, "wrong_fix_confidence_max", &S::wrong_fix_confidence_max, "");
+  Summary(cls, "distance_to_fix_median_m", &S::distance_to_fix_median_m, "Over fixed starts.");
+  Summary(cls, "distance_to_fix_p90_m", &S::distance_to_fix_p90_m, "");
+  Summary(cls, "scans_to_fix_median", &S::scans_to_fix_median, "");
+  Summary(cls, "distance_after_revisit_median_m", &S::distance_after_revisit_median_m,
+          "From the first scan the map has seen to the first fix.");
+  Summary(cls, "distance_after_revisit_p90_m", &S::distance_after_revisit_p90_m, "");
+  Summary(cls, "update_seconds_mean", &S::update_seconds_mean, "Per update (s).");
+  Summary(cls, "update_seconds_max", &S::update_seconds_max, "");
+  Summary(cls, "lost_signals", &S::lost_signals, "");
+  Summary(cls, "lost_on_correct_track", &S::lost_on_correct_track, "");
+  Summary(cls, "lost_on_wrong_track", &S::lost_on_wrong_track, "");
+  cls.def_readonly("config", &PyRelocalization::config,
+                   "The keyplace.Config of the run (the CLI's JSON 'config').")
+      .def_readonly("keypoint_seconds_per_scan", &PyRelocalization::keypoint_seconds_per_scan)
+      .def_readonly("query_log_is_map_log", &PyRelocalization::query_log_is_map_log)
+      .def_property_readonly(
+          "scans",
+          [](const PyRelocalization& r) { return std::make_pair(r.first_scan, r.end_scan); },
+          "(first, end) scans of the query log the starts were spread over.")
+      .def_property_readonly("pose_source",
+                             [](const PyRelocalization& r) { return ToString(r.pose_source); })
+      .def_property_readonly(
+          "exclude_shared_scans",
+          [](const PyRelocalization& r) { return r.options.exclude_shared_scans; },
+          "Map submaps sharing a scan with the query were skipped (the map's own log).")
+      .def_property_readonly("give_up_m",
+                             [](const PyRelocalization& r) { return r.options.give_up_m; })
+      .def_property_readonly("follow_m",
+                             [](const PyRelocalization& r) { return r.options.follow_m; })
+      .def_readonly("records", &PyRelocalization::records, "One StartRecord per start.")
+      .def(
+          "first_fix",
+          [](const PyRelocalization& r) -> py::object {
+            const std::optional<FirstFix> first = FirstFixOf(r.records);
+            if (!first) return py::none();
+            return py::make_tuple(first->start_scan, first->fix);
+          },
+          "(start_scan, FixEvent) of the first fix of the first start that got one, or None.")
+      .def(
+          "initial_pose",
+          [](const PyRelocalization& r, const std::string& frame_id) -> py::object {
+            const std::optional<FirstFix> first = FirstFixOf(r.records);
+            if (!first) return py::none();
+            return py::cast(InitialPoseOf(first->fix, frame_id));
+          },
+          py::arg("frame_id") = "map",
+          "The first fix as the /initialpose message (what `--initialpose` writes), or None.");
+}
+
+}  // namespace
+
+void BindRelocalization(py::module_& module) {
+  BindRecords(module);
+  BindRelocalizationEvaluation(module);
+  module.def("relocalize", &Relocalize, py::arg("log"), py::arg("map"),
+             py::arg("config") = py::none(), py::arg("overrides") = py::none(),
+             py::arg("poses") = "corrected", py::arg("truth") = py::none(),
+             py::arg("index") = py::none(), py::arg("scans") = py::none(), py::arg("starts") = 50,
+             py::arg("self_match") = "shared-scan", py::arg("skip_bad_lines") = false,
+             py::arg("progress") = py::none(),
+             "relocalize(log, map, config=None, overrides=None, poses='corrected', truth=None, "
+             "index=None, scans=None, starts=50, self_match='shared-scan', "
+             "skip_bad_lines=False, progress=None) -> RelocalizationEvaluation: the "
+             "kidnapped-robot benchmark `keyplace relocalize` runs: from `starts` starts over the "
+             "log a Relocalizer knowing nothing is fed scans and odometry (poses) until it fixes "
+             "or gives up; every fix is checked against the truth (the log's corrected poses, or "
+             "truth + index for a raw log). map: a Map or a .kpm path; config None is the strict "
+             "preset, as in the CLI; progress(done, total) after each start. The starts run in "
+             "parallel on all cores.");
+}
+
+}  // namespace keyplace::python
