@@ -107,7 +107,9 @@ void RegisterOdometryCommand(CLI::App& app) {
       "odometry",
       "Scan-matching odometry on a raw log: every scan is registered with point-to-line ICP "
       "against a local map of the last key scans, initialised by the odometry increment; when "
-      "ICP fails the odometry increment is used and the scan is counted as a fallback. Prints "
+      "ICP fails from there, it is retried from the best pose of a correlative search around the "
+      "prediction (counted as recovered), and if that fails too the odometry increment is used "
+      "and the scan is counted as a fallback. Prints "
       "the run statistics and, with --relations, the relation error of Kümmerle et al. (2009) "
       "for the ICP trajectory and for raw odometry: mean ± std of the translational (m) and "
       "rotational (deg) error of the relative poses, over all relations and split into local "

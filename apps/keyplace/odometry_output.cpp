@@ -83,24 +83,30 @@ void PrintOdometryDrift(const OdometryDrift& drift) {
         std::pair<std::string, const DriftReport&>{"odometry", drift.odometry}}) {
     fmt::print(
         "  {:<10} consecutive {:.4f} ± {:.4f} m, {:.3f} ± {:.3f} deg; ATE rmse {:.3f} m "
-        "(max {:.3f} m), {:.2f} deg; worst {}-step heading {:.2f} deg (from raw scan {})\n",
+        "(max {:.3f} m), {:.2f} deg; worst {}-step heading {}\n",
         name, d.consecutive.translation_mean_m, d.consecutive.translation_std_m,
         d.consecutive.rotation_mean_deg, d.consecutive.rotation_std_deg, d.ate_rmse_m, d.ate_max_m,
-        d.ate_rotation_rmse_deg, kDriftWindowSteps, d.window_heading_max_deg,
-        d.window_start_raw_index);
+        d.ate_rotation_rmse_deg, kDriftWindowSteps,
+        d.window_heading_max_deg ? fmt::format("{:.2f} deg (from raw scan {})",
+                                               *d.window_heading_max_deg, d.window_start_raw_index)
+                                 : std::string("n/a (too few scans)"));
   }
 }
 
 nlohmann::json DriftJson(const DriftReport& d) {
-  return {{"pairs", d.pairs},
-          {"consecutive", StatsJson(d.consecutive)},
-          {"ate_rmse_m", d.ate_rmse_m},
-          {"ate_mean_m", d.ate_mean_m},
-          {"ate_max_m", d.ate_max_m},
-          {"ate_rotation_rmse_deg", d.ate_rotation_rmse_deg},
-          {"window_steps", kDriftWindowSteps},
-          {"window_heading_max_deg", d.window_heading_max_deg},
-          {"window_start_raw_index", d.window_start_raw_index}};
+  return {
+      {"pairs", d.pairs},
+      {"consecutive", StatsJson(d.consecutive)},
+      {"ate_rmse_m", d.ate_rmse_m},
+      {"ate_mean_m", d.ate_mean_m},
+      {"ate_max_m", d.ate_max_m},
+      {"ate_rotation_rmse_deg", d.ate_rotation_rmse_deg},
+      {"window_steps", kDriftWindowSteps},
+      {"window_heading_max_deg", d.window_heading_max_deg
+                                     ? nlohmann::json(*d.window_heading_max_deg)
+                                     : nlohmann::json(nullptr)},
+      {"window_start_raw_index", d.window_heading_max_deg ? nlohmann::json(d.window_start_raw_index)
+                                                          : nlohmann::json(nullptr)}};
 }
 
 void WriteRelationErrorsTsv(const std::string& path, const std::vector<Relation>& relations,

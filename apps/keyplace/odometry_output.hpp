@@ -12,7 +12,8 @@
 
 namespace keyplace::cli {
 
-/// "scans ... of ... (... order)", registered, fallbacks, degenerate, key scans, time per scan.
+/// "scans ... of ... (... order)", registered, recovered, fallbacks, degenerate, key scans, time
+/// per scan.
 void PrintOdometryRun(const OdometryRun& run);
 /// The run statistics as flat keys (scans, scans_in_log, registered, ..., iterations_mean).
 nlohmann::json OdometryRunJson(const OdometryRun& run);

@@ -221,7 +221,7 @@ DriftReport EvaluateDrift(const std::vector<Pose2>& estimate_by_raw_index,
     const Pose2 truth = Between(corrected_by_corrected_index[first.corrected_index],
                                 corrected_by_corrected_index[pairs[k].corrected_index]);
     const double heading_deg = RelativePoseError(estimated, truth).rotation_deg;
-    if (heading_deg > report.window_heading_max_deg) {
+    if (!report.window_heading_max_deg || heading_deg > *report.window_heading_max_deg) {
       report.window_heading_max_deg = heading_deg;
       report.window_start_raw_index = first.raw_index;
     }

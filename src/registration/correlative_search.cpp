@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace keyplace {
 namespace {
 
-// Cell coordinates further out than this are outside any field (which is at most a few thousand
+// Cell coordinates further out than this are outside any field (at most kMaxProximityFieldWidth
 // cells wide); clamping to it keeps the integer arithmetic of the search from overflowing.
 constexpr double kFarCell = 1e6;
 
@@ -18,17 +19,37 @@ int CellIndex(double coordinate) {
 
 double Square(double value) { return value * value; }
 
+double CheckedPositive(double value, const char* name) {
+  if (!(std::isfinite(value) && value > 0.0)) {
+    throw std::invalid_argument(std::string("ProximityField: ") + name + " must be finite and > 0");
+  }
+  return value;
+}
+
+// The cell side: `cell_m`, or larger when the extent needs more than the widest grid.
+double FieldCell(double half_extent_m, double cell_m) {
+  CheckedPositive(half_extent_m, "half_extent_m");
+  CheckedPositive(cell_m, "cell_m");
+  return std::max(cell_m, 2.0 * half_extent_m / kMaxProximityFieldWidth);
+}
+
 }  // namespace
 
 ProximityField::ProximityField(const std::vector<Eigen::Vector2d>& target_points,
                                const Eigen::Vector2d& centre, double half_extent_m, double cell_m,
                                double sigma_m)
-    : cell_m_(cell_m),
+    : cell_m_(FieldCell(half_extent_m, cell_m)),
       origin_(centre - Eigen::Vector2d(half_extent_m, half_extent_m)),
-      width_(std::max(1, static_cast<int>(std::ceil(2.0 * half_extent_m / cell_m)))) {
+      width_(std::min(kMaxProximityFieldWidth,
+                      std::max(1, static_cast<int>(std::ceil(2.0 * half_extent_m / cell_m_))))) {
+  CheckedPositive(sigma_m, "sigma_m");
+  if (!centre.allFinite()) throw std::invalid_argument("ProximityField: centre must be finite");
   values_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(width_), 0.0F);
+  // Closeness is sampled at cell centres: a sigma below the cell would miss points between them.
+  sigma_m = std::max(sigma_m, cell_m_);
   const double reach_m = 3.0 * sigma_m;
-  const int reach_cells = static_cast<int>(std::ceil(reach_m / cell_m));
+  const int reach_cells =
+      std::min(kMaxProximityFieldWidth, static_cast<int>(std::ceil(reach_m / cell_m_)));
   const double inverse_two_sigma2 = 1.0 / (2.0 * sigma_m * sigma_m);
   for (const Eigen::Vector2d& point : target_points) {
     const Eigen::Vector2d cell = CellCoordinates(point);
@@ -65,6 +86,12 @@ CorrelativeMatch SearchCorrelative(const ProximityField& field,
   CorrelativeMatch best;
   best.T_target_source = T_target_source_guess;
   if (source.empty()) return best;
+  const double inverse_n = 1.0 / static_cast<double>(source.size());
+  // The guess first: with prior 1 it wins every tie.
+  for (const Eigen::Vector2d& p : source) {
+    best.score_at_guess += field.At(T_target_source_guess * p) * inverse_n;
+  }
+  best.score = best.score_at_guess;
   // Translations move whole cells, so a rotated scan's cells are computed once per rotation.
   const int step_cells =
       std::max(1, static_cast<int>(std::lround(window.translation_step_m / field.cell_m())));
@@ -77,10 +104,8 @@ CorrelativeMatch SearchCorrelative(const ProximityField& field,
       window.rotation_rad > 0.0 && window.rotation_step_rad > 0.0
           ? static_cast<int>(std::floor(window.rotation_rad / window.rotation_step_rad + 1e-9))
           : 0;
-  const double inverse_n = 1.0 / static_cast<double>(source.size());
   std::vector<int> columns(source.size());
   std::vector<int> rows(source.size());
-  double best_score = -std::numeric_limits<double>::infinity();
   for (int ir = -rotation_steps; ir <= rotation_steps; ++ir) {
     const double rotation_offset_rad = ir * window.rotation_step_rad;
     const Pose2 rotated(T_target_source_guess.x, T_target_source_guess.y,
@@ -99,15 +124,14 @@ CorrelativeMatch SearchCorrelative(const ProximityField& field,
           sum += field.AtCell(columns[i] + ix * step_cells, rows[i] + iy * step_cells);
         }
         const double closeness = sum * inverse_n;
-        if (ir == 0 && ix == 0 && iy == 0) best.score_at_guess = closeness;
         const double translation_prior =
             translation_steps > 0
                 ? (Square(ix * step_m) + Square(iy * step_m)) / Square(window.translation_m)
                 : 0.0;
         const double score = closeness * std::exp(-0.5 * (translation_prior + rotation_prior));
-        if (score > best_score) {
-          best_score = score;
+        if (score > best.score) {
           best.score = score;
+          best.moved = ix != 0 || iy != 0 || ir != 0;
           best.T_target_source =
               Pose2(rotated.x + ix * step_m, rotated.y + iy * step_m, rotated.theta);
         }

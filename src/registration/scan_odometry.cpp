@@ -12,6 +12,8 @@
 namespace keyplace {
 namespace {
 
+constexpr double kMaxRecoveryPoses = 1e6;
+
 void Require(bool condition, const char* field, const char* what) {
   if (!condition) {
     throw std::invalid_argument(std::string("ScanOdometryConfig.") + field + " " + what);
@@ -64,10 +66,20 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
           "recovery_window_translation_m", "must be in [0, 10]");
   Require(c.recovery_window_rotation_rad >= 0.0 && c.recovery_window_rotation_rad <= M_PI,
           "recovery_window_rotation_rad", "must be in [0, pi]");
-  // The search costs (window / step)^2 translations per rotation: these floors keep one search
-  // below a few hundred million point lookups.
-  Require(c.recovery_step_translation_m >= 0.01, "recovery_step_translation_m", "must be >= 0.01");
-  Require(c.recovery_step_rotation_rad >= 0.001, "recovery_step_rotation_rad", "must be >= 0.001");
+  Require(std::isfinite(c.recovery_step_translation_m) && c.recovery_step_translation_m >= 0.01,
+          "recovery_step_translation_m", "must be finite and >= 0.01");
+  Require(std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
+          "recovery_step_rotation_rad", "must be finite and >= 0.001");
+  // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 91 =
+  // 11 011 poses (2-6 ms); this bound keeps a search under about a second.
+  const double translations =
+      2.0 * std::floor(c.recovery_window_translation_m / c.recovery_step_translation_m) + 1.0;
+  const double rotations =
+      2.0 * std::floor(c.recovery_window_rotation_rad / c.recovery_step_rotation_rad) + 1.0;
+  Require(translations * translations * rotations <= kMaxRecoveryPoses,
+          "recovery_window_translation_m",
+          "and the other recovery_window_* / recovery_step_* fields give more than 1 000 000 "
+          "searched poses");
 }
 
 ScanOdometry::ScanOdometry(const ScanOdometryConfig& config) : config_(config) {
@@ -146,6 +158,7 @@ std::optional<IcpResult> ScanOdometry::Recover(const std::vector<Eigen::Vector2d
                              window.translation_step_m / 2.0, sigma_m);
   const CorrelativeMatch match =
       SearchCorrelative(field, source_laser, predicted_T_world_laser, window);
+  if (!match.moved) return std::nullopt;  // ICP from the same start would fail the same way
   IcpResult icp = AlignPointToLine(*target_, source_laser, match.T_target_source, config_.icp);
   if (!icp.converged) return std::nullopt;
   const Pose2 refinement = Between(match.T_target_source, icp.T_target_source);

@@ -189,7 +189,11 @@ TEST(RelationErrorTest, DriftAgainstCorrectedPoses) {
   EXPECT_NEAR(exact.consecutive.translation_mean_m, 0.0, 1e-9);
   EXPECT_NEAR(exact.ate_rmse_m, 0.0, 1e-9);
   EXPECT_NEAR(exact.ate_rotation_rmse_deg, 0.0, 1e-7);
-  EXPECT_NEAR(exact.window_heading_max_deg, 0.0, 1e-7);
+  ASSERT_TRUE(exact.window_heading_max_deg.has_value());
+  EXPECT_NEAR(*exact.window_heading_max_deg, 0.0, 1e-7);
+  // Five steps need six pairs.
+  const std::vector<IndexPair> five(pairs.begin(), pairs.begin() + 5);
+  EXPECT_FALSE(EvaluateDrift(raw, corrected, five).window_heading_max_deg.has_value());
   const Pose2 T_corrected_raw = T_raw_corrected.inverse();
   EXPECT_NEAR(exact.T_corrected_estimate.theta, T_corrected_raw.theta, 1e-9);
   EXPECT_NEAR(exact.T_corrected_estimate.x, T_corrected_raw.x, 1e-9);
@@ -208,7 +212,8 @@ TEST(RelationErrorTest, DriftAgainstCorrectedPoses) {
     slipped[i] = slipped_21 * Between(raw[21], raw[i]);
   }
   const DriftReport slip = EvaluateDrift(slipped, corrected, pairs);
-  EXPECT_NEAR(slip.window_heading_max_deg, 30.0, 0.01);
+  ASSERT_TRUE(slip.window_heading_max_deg.has_value());
+  EXPECT_NEAR(*slip.window_heading_max_deg, 30.0, 0.01);
   EXPECT_GE(slip.window_start_raw_index, 11u);
   EXPECT_LE(slip.window_start_raw_index, 19u);
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -71,6 +72,7 @@ TEST(CorrelativeSearch, FindsTheTruePoseFarFromTheGuess) {
   EXPECT_LT(std::abs(match.T_target_source.y - T_world_laser.y), 0.1);
   EXPECT_LT(std::abs(WrapAngle(match.T_target_source.theta - T_world_laser.theta)), DegToRad(1.5));
   EXPECT_GT(match.score, 2.0 * match.score_at_guess);
+  EXPECT_TRUE(match.moved);
 
   // Outside the window the true pose cannot be found: a 60 deg error stays wrong.
   const Pose2 far_guess(T_world_laser.x, T_world_laser.y, T_world_laser.theta - DegToRad(60.0));
@@ -99,6 +101,34 @@ TEST(CorrelativeSearch, InAFeaturelessDirectionTheGuessWins) {
   EXPECT_NEAR(match.T_target_source.x, 0.3, 1e-9);
   EXPECT_NEAR(match.T_target_source.y, 0.0, 1e-9);
   EXPECT_NEAR(match.T_target_source.theta, 0.0, 1e-9);
+  EXPECT_FALSE(match.moved);
+}
+
+// Far from every target point nothing scores: the guess wins, not a corner of the window.
+TEST(CorrelativeSearch, NothingInReachKeepsTheGuess) {
+  const ProximityField field({{0.0, 0.0}}, {0.0, 0.0}, 50.0, 0.05, 0.1);
+  const Pose2 guess(20.0, 20.0, 0.3);
+  const CorrelativeMatch match =
+      SearchCorrelative(field, {{1.0, 0.0}, {0.0, 1.0}}, guess, CorrelativeWindow{});
+  EXPECT_FALSE(match.moved);
+  EXPECT_EQ(match.T_target_source.x, guess.x);
+  EXPECT_EQ(match.T_target_source.y, guess.y);
+  EXPECT_EQ(match.T_target_source.theta, guess.theta);
+  EXPECT_EQ(match.score, 0.0);
+}
+
+// An extent needing more cells than the widest grid gets coarser cells, not unbounded memory;
+// sizes that are no positive finite numbers are refused.
+TEST(ProximityField, WideExtentsGetCoarserCellsAndBadSizesAreRefused) {
+  const ProximityField wide({{0.0, 0.0}}, {0.0, 0.0}, 1000.0, 0.05, 0.1);
+  EXPECT_EQ(wide.width(), kMaxProximityFieldWidth);
+  EXPECT_NEAR(wide.cell_m(), 2000.0 / kMaxProximityFieldWidth, 1e-12);
+  EXPECT_GT(wide.At({0.0, 0.0}), 0.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(ProximityField({}, {0.0, 0.0}, inf, 0.05, 0.1), std::invalid_argument);
+  EXPECT_THROW(ProximityField({}, {0.0, 0.0}, 1.0, 0.0, 0.1), std::invalid_argument);
+  EXPECT_THROW(ProximityField({}, {0.0, 0.0}, 1.0, 0.05, -1.0), std::invalid_argument);
+  EXPECT_THROW(ProximityField({}, {inf, 0.0}, 1.0, 0.05, 0.1), std::invalid_argument);
 }
 
 TEST(CorrelativeSearch, EmptySourceKeepsTheGuess) {

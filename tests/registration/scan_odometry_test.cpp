@@ -1,6 +1,7 @@
 #include "keyplace/registration/scan_odometry.hpp"
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -244,6 +245,19 @@ TEST(ScanOdometryTest, RecoveryConfigIsValidated) {
   ScanOdometryConfig config;
   config.recovery_step_translation_m = 0.0;
   EXPECT_THROW(ScanOdometry{config}, std::invalid_argument);
+  config = ScanOdometryConfig{};
+  config.recovery_step_rotation_rad = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(ScanOdometry{config}, std::invalid_argument);
+  // 101 x 101 translations x 1571 rotations: too many poses for one search.
+  config = ScanOdometryConfig{};
+  config.recovery_step_translation_m = 0.01;
+  config.recovery_step_rotation_rad = 0.001;
+  try {
+    ScanOdometry odometry(config);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("searched poses"), std::string::npos);
+  }
   config = ScanOdometryConfig{};
   config.recovery_window_rotation_rad = 4.0;
   try {

@@ -3,6 +3,7 @@
 // (SLAM-optimised) poses.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,8 +102,8 @@ struct DriftReport {
   ErrorStats consecutive;
   // The worst heading error of the relative motion across kDriftWindowSteps consecutive steps
   // (a lost turn shows here even when the next scans register well again), and the raw index of
-  // the window's first scan.
-  double window_heading_max_deg = 0.0;
+  // the window's first scan; nullopt with kDriftWindowSteps pairs or fewer.
+  std::optional<double> window_heading_max_deg;
   std::size_t window_start_raw_index = 0;
   // Absolute trajectory error after the least-squares SE(2) alignment (no scale) of the
   // estimated positions onto the corrected positions.
