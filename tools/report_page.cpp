@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "report_figures.hpp"
+#include "report_hospital.hpp"
 #include "report_tables.hpp"
 
 namespace keyplace::cli {
@@ -93,6 +94,7 @@ std::string PageHeader(const ReportContext& context, double run_seconds) {
       "<a href=\"#mapping\">Table II, Figure 8, Table VI</a> · <a href=\"#place\">Tables III–V, "
       "Figure 9, Tables VII–VIII</a> · <a href=\"#relocalize\">kidnapped robot</a> · "
       "<a href=\"#slam\">Table IX, loops, Figures 10–12</a> · "
+      "<a href=\"#hospital\">hospital bag</a> · "
       "<a href=\"#table10\">Table X</a> · <a href=\"#commands\">commands</a></p>\n";
   return html;
 }
@@ -136,6 +138,7 @@ std::string BuildPage(ReportContext& context, double run_seconds) {
   body += "<h2 id=\"slam\">SLAM with loop closure (Section 6.2.2)</h2>\n";
   body += TableIX(context);
   body += SlamFigures(context);
+  body += HospitalSection(context);
   body += "<h2 id=\"comparison\">Comparison with TIP-FLIRT (Section 6.3)</h2>\n";
   body += TableX(context);
   body += WarningsSection(context);

@@ -171,6 +171,16 @@ std::string ReportArtefacts::SlamDir(const ReportSettings& s, const std::string&
   return Join(s.work_dir, "slam/" + base + "-raw");
 }
 
+std::string ReportArtefacts::HospitalBag(const ReportSettings& s) {
+  return Join(s.data_dir, "fr-clinic.orig.bag");
+}
+std::string ReportArtefacts::HospitalRelations(const ReportSettings& s) {
+  return Join(s.data_dir, "fr-clinic.relations");
+}
+std::string ReportArtefacts::HospitalSlamDir(const ReportSettings& s) {
+  return Join(s.work_dir, "slam/fr-clinic-bag");
+}
+
 std::vector<ReportStep> PlanReport(const ReportSettings& s) {
   using A = ReportArtefacts;
   std::vector<ReportStep> steps;
@@ -317,6 +327,18 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
                      "Table IX and Figures 10-12, " + f.name + "_r",
                      slam_args,
                      {raw, log, f.index},
+                     {Join(slam, "slam.json"), Join(slam, "figures/trajectory.png")}});
+  }
+  // SLAM on the hospital bag (no corrected poses: relation error and trajectory only); a full
+  // report only, as it takes minutes.
+  if (!s.quick && Exists(A::HospitalBag(s)) && Exists(A::HospitalRelations(s))) {
+    const std::string slam = A::HospitalSlamDir(s);
+    steps.push_back({"slam-fr-clinic-bag",
+                     "SLAM on the Freiburg hospital bag (issue 17's check set)",
+                     {"slam", A::HospitalBag(s), "--relations", A::HospitalRelations(s), "--json",
+                      Join(slam, "slam.json"), "--loops", Join(slam, "loops.tsv"), "--figures",
+                      Join(slam, "figures")},
+                     {A::HospitalBag(s), A::HospitalRelations(s)},
                      {Join(slam, "slam.json"), Join(slam, "figures/trajectory.png")}});
   }
   return steps;

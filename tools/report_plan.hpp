@@ -47,6 +47,11 @@ struct ReportArtefacts {
   static std::string Fig9Dir(const ReportSettings& s, const std::string& base,
                              const std::string& preset);
   static std::string SlamDir(const ReportSettings& s, const std::string& base);
+  /// The hospital bag (issue 17's check set): DATA/fr-clinic.orig.bag, its relations, and the
+  /// directory of its keyplace slam run.
+  static std::string HospitalBag(const ReportSettings& s);
+  static std::string HospitalRelations(const ReportSettings& s);
+  static std::string HospitalSlamDir(const ReportSettings& s);
 };
 
 /// One keyplace run of the plan.

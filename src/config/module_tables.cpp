@@ -152,7 +152,8 @@ const ConfigFields<SlamConfig>& SlamConfigFields() {
         .Double("exclude_recent_path_m", &C::exclude_recent_path_m, "m",
                 "... nor with submaps less than this path behind it")
         .Bool("all_scan_loop_queries", &C::all_scan_loop_queries,
-              "loop queries with the keypoints of all the submap's scans, not its stable ones")
+              "loop queries with the keypoints of all the submap's scans, not its stable ones "
+              "(when place.query_keypoints = all_scans)")
         .Double("gate_base_m", &C::gate_base_m, "m",
                 "loop gate: allowed disagreement with the estimate (0 = no gate) ...")
         .Double("gate_per_path", &C::gate_per_path, "m/m", "... plus this per m of path")

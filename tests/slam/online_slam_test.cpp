@@ -115,23 +115,31 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   std::vector<std::vector<Keypoint>> keypoints;
   keypoints.reserve(run.scans.size());
   for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  std::size_t rejected_by_point_overlap = 0;
   auto loops_found = [&](bool all_scan_loop_queries, double min_gamma_all_scans,
                          PlaceRecognitionConfig::QueryKeypoints query_keypoints =
-                             PlaceRecognitionConfig::QueryKeypoints::kAllScans) {
+                             PlaceRecognitionConfig::QueryKeypoints::kAllScans,
+                         double min_point_overlap = LoopRefinementConfig{}.min_point_overlap) {
     SlamConfig config = SimulationConfig();
     config.all_scan_loop_queries = all_scan_loop_queries;
     config.place.query_keypoints = query_keypoints;
     config.place.min_gamma = 1.0;
     config.place.min_gamma_all_scans = min_gamma_all_scans;
+    config.loop_refinement.min_point_overlap = min_point_overlap;
     OnlineSlam slam(config);
     for (std::size_t i = 0; i < run.scans.size(); ++i) {
       slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints[i]);
     }
     slam.Finish();
+    rejected_by_point_overlap = slam.stats().loops_rejected_by_point_overlap;
     return slam.loops().size();
   };
   EXPECT_EQ(loops_found(false, 0.0), 0U);  // stable-keypoint queries
-  EXPECT_GE(loops_found(true, 0.0), 1U);
+  const std::size_t all_scan_loops = loops_found(true, 0.0);
+  EXPECT_GE(all_scan_loops, 1U);
+  // The dense point-overlap check drops every match when nothing can overlap enough.
+  EXPECT_EQ(loops_found(true, 0.0, PlaceRecognitionConfig::QueryKeypoints::kAllScans, 1.0), 0U);
+  EXPECT_GE(rejected_by_point_overlap, 1U);
   EXPECT_EQ(loops_found(true, 1.0), 0U);  // held to min_gamma_all_scans
   // With stable place queries (the paper preset) the loop detector queries with stable ones too.
   EXPECT_EQ(loops_found(true, 0.0, PlaceRecognitionConfig::QueryKeypoints::kStable), 0U);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "report_context.hpp"
+#include "report_hospital.hpp"
 #include "report_plan.hpp"
 #include "report_tables.hpp"
 
@@ -155,6 +156,58 @@ TEST(ReportTablesTest, KidnappedRobotTableRendersTheJsonAndNamesWhatIsMissing) {
                       "<code>keyplace relocalize --map "),
             std::string::npos)
       << html;
+}
+
+// Issue 17: a full report runs keyplace slam on the hospital bag when the bag and its relations
+// are in the data directory, and its section shows the relation error beside the published ones.
+TEST(ReportHospitalTest, PlannedWhenTheBagExistsAndRenderedFromItsJson) {
+  const fs::path dir = fs::temp_directory_path() / "keyplace_report_hospital_test";
+  fs::remove_all(dir);
+  ReportContext context;
+  context.settings.data_dir = (dir / "data").string();
+  context.settings.work_dir = (dir / "work").string();
+  context.settings.datasets = {"fr079"};
+  auto planned = [&](bool quick) {
+    ReportSettings settings = context.settings;
+    settings.quick = quick;
+    const std::vector<ReportStep> steps = PlanReport(settings);
+    return IndexOf(steps, "slam-fr-clinic-bag") < steps.size();
+  };
+  EXPECT_FALSE(planned(false));  // no bag
+  fs::create_directories(dir / "data");
+  std::ofstream(ReportArtefacts::HospitalBag(context.settings)) << "bag";
+  EXPECT_FALSE(planned(false));  // no relations
+  std::ofstream(ReportArtefacts::HospitalRelations(context.settings)) << "relations";
+  EXPECT_TRUE(planned(false));
+  EXPECT_FALSE(planned(true));  // minutes of work: not in a quick report
+  context.steps = PlanReport(context.settings);
+  context.outcomes.resize(context.steps.size());
+  const ReportStep& step = context.steps[IndexOf(context.steps, "slam-fr-clinic-bag")];
+  EXPECT_EQ(CommandLine(step),
+            "keyplace slam " + (dir / "data/fr-clinic.orig.bag").string() + " --relations " +
+                (dir / "data/fr-clinic.relations").string() + " --json " +
+                (dir / "work/slam/fr-clinic-bag/slam.json").string() + " --loops " +
+                (dir / "work/slam/fr-clinic-bag/loops.tsv").string() + " --figures " +
+                (dir / "work/slam/fr-clinic-bag/figures").string());
+
+  // Before the run: a note saying how to make it.
+  std::string html = HospitalSection(context);
+  EXPECT_NE(html.find("not computed: run <code>keyplace slam "), std::string::npos) << html;
+  const fs::path json = dir / "work/slam/fr-clinic-bag/slam.json";
+  fs::create_directories(json.parent_path());
+  std::ofstream(json) << R"({"loops_detected": 26, "loops_used": 16, "relations": {
+    "translation_mean_m": 0.1401, "translation_std_m": 0.2154, "local_translation_mean_m": 0.0837,
+    "local_translation_std_m": 0.1066, "loop_translation_mean_m": 0.1902,
+    "loop_translation_std_m": 0.2687}})";
+  html = HospitalSection(context);
+  fs::remove_all(dir);
+  EXPECT_NE(html.find("<tr><td>keyplace slam</td><td>26 / 16</td><td>0.140 ± 0.215 m</td>"
+                      "<td>0.084 ± 0.107 m</td><td>0.190 ± 0.269 m</td></tr>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("0.143 ± 0.180 m"), std::string::npos);
+  // The trajectory figure is missing: its note names the step.
+  EXPECT_NE(html.find("not computed: run <code>keyplace slam "), std::string::npos) << html;
 }
 
 }  // namespace

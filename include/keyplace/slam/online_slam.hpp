@@ -130,8 +130,8 @@ struct SlamStats {
   std::size_t loops_accepted = 0;         // passed the gate
   std::size_t loops_refined = 0;          // loop transform refined by ICP
   std::size_t loops_partner_changed = 0;  // partner is a neighbour of the matched submap
-  // Found matches not taken as loops by the optional point-overlap verification
-  // (loop_refinement.min_point_overlap; 0 by default, then always 0).
+  // Found matches not taken as loops by the point-overlap verification
+  // (loop_refinement.min_point_overlap; always 0 when it is 0).
   std::size_t loops_rejected_by_point_overlap = 0;
   std::size_t optimizations = 0;
   std::size_t solves = 0;
