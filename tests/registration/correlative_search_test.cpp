@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "keyplace/registration/scan_odometry.hpp"
 #include "synthetic_scene.hpp"
 
 namespace keyplace {
@@ -17,14 +18,9 @@ using testing::CastScan;
 using testing::DegToRad;
 using testing::ScanOptions;
 
+// The scan's usable endpoints, as scan odometry takes them.
 std::vector<Eigen::Vector2d> Endpoints(const LaserScan& scan) {
-  std::vector<Eigen::Vector2d> points;
-  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
-    if (scan.valid[i] == 0) continue;
-    points.emplace_back(scan.ranges_m[i] * std::cos(scan.angles_rad[i]),
-                        scan.ranges_m[i] * std::sin(scan.angles_rad[i]));
-  }
-  return points;
+  return ScanOdometry::FilteredEndpoints(scan, ScanOdometryConfig{});
 }
 
 std::vector<Eigen::Vector2d> InWorld(const std::vector<Eigen::Vector2d>& points,
