@@ -1,20 +1,32 @@
 // ReadSqliteMessages: a rosbag2 sqlite3 storage file (tables topics(id, name, type,
 // serialization_format, ...) and messages(id, topic_id, timestamp, data)), opened read-only and
-// immutable (no journal, no lock files beside a bag that may lie on a read-only disk).
+// immutable (no journal, no lock files beside a bag that may lie on a read-only disk), with the
+// connection hardened as for map files (io/sqlite_hardening.hpp): the file may come from anywhere.
 
 #include <sqlite3.h>
 
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "io/ros2_storage.hpp"
+#include "io/sqlite_hardening.hpp"
 
 namespace keyplace {
 namespace {
 
 // A message larger than this is damage (a 10^5-beam scan is 400 kB).
-constexpr int kMaxBlobBytes = 256 << 20;
+constexpr std::uint64_t kMaxBlobBytes = 256U << 20U;
+// Reading the fixture bag (528 kB, 450 messages) takes about 0.05 instructions per byte; a
+// bag's messages are read once, by their rowid.
+constexpr std::uint64_t kInstructionsPerFileByte = 64;
 
 struct CloseDatabase {
   void operator()(sqlite3* db) const { sqlite3_close(db); }
@@ -42,17 +54,32 @@ std::string FileUri(const std::string& path) {
   return uri + "?immutable=1";
 }
 
+// The columns keyplace reads, per table; each must be an ordinary stored column.
+struct RequiredTable {
+  const char* name;
+  std::vector<const char*> columns;
+};
+const std::vector<RequiredTable>& RequiredTables() {
+  static const std::vector<RequiredTable> tables = {
+      {"topics", {"id", "name", "type", "serialization_format"}},
+      {"messages", {"topic_id", "timestamp", "data"}}};
+  return tables;
+}
+
 class SqliteBag {
  public:
   explicit SqliteBag(const std::string& path) : path_(path) {
+    std::error_code error;
+    const std::uint64_t file_bytes = std::filesystem::file_size(path, error);
     sqlite3* raw = nullptr;
     const int status = sqlite3_open_v2(FileUri(path).c_str(), &raw,
                                        SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
     db_.reset(raw);
     if (status != SQLITE_OK) Fail("cannot open the sqlite3 file");
-    sqlite3_limit(db_.get(), SQLITE_LIMIT_LENGTH, kMaxBlobBytes);
-    sqlite3_db_config(db_.get(), SQLITE_DBCONFIG_DEFENSIVE, 1, nullptr);
-    sqlite3_db_config(db_.get(), SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
+    if (!HardenReadOnlyConnection(db_.get(), error ? 0 : file_bytes, kMaxBlobBytes,
+                                  kInstructionsPerFileByte, budget_)) {
+      Fail("cannot configure SQLite");
+    }
   }
 
   StorageWalk Walk(const StorageVisitor& visitor) {
@@ -67,18 +94,29 @@ class SqliteBag {
       walk.topics.push_back(topic);
       topics[sqlite3_column_int64(topic_rows.get(), 0)] = std::move(topic);
     }
-    Statement messages =
-        Prepare("SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
-    while (Step(messages)) {
-      const sqlite3_int64 topic_id = sqlite3_column_int64(messages.get(), 0);
+    // Messages in (timestamp, id) order, the order rosbag2 plays them. The order is made here
+    // from the stamps and rowids alone (16 bytes a message) rather than by SQLite's sorter, which
+    // would copy every blob into temporary files; each blob is then read once by its rowid.
+    std::vector<std::pair<sqlite3_int64, sqlite3_int64>> order;  // (timestamp, rowid)
+    Statement stamps = Prepare("SELECT timestamp, rowid FROM messages");
+    while (Step(stamps)) {
+      order.emplace_back(sqlite3_column_int64(stamps.get(), 0),
+                         sqlite3_column_int64(stamps.get(), 1));
+    }
+    std::sort(order.begin(), order.end());
+    Statement message = Prepare("SELECT topic_id, data FROM messages WHERE rowid = ?");
+    for (const auto& [stamp_ns, rowid] : order) {
+      sqlite3_reset(message.get());
+      sqlite3_bind_int64(message.get(), 1, rowid);
+      if (!Step(message)) Fail("message row " + std::to_string(rowid) + " vanished");
+      const sqlite3_int64 topic_id = sqlite3_column_int64(message.get(), 0);
       const auto topic = topics.find(topic_id);
       if (topic == topics.end()) {
         Fail("a message of topic id " + std::to_string(topic_id) +
              ", which the topics table does not hold");
       }
-      const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(messages.get(), 2));
-      const int size = sqlite3_column_bytes(messages.get(), 2);
-      const sqlite3_int64 stamp_ns = sqlite3_column_int64(messages.get(), 1);
+      const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(message.get(), 1));
+      const int size = sqlite3_column_bytes(message.get(), 1);
       visitor({topic->second, static_cast<std::uint64_t>(stamp_ns < 0 ? 0 : stamp_ns), data,
                static_cast<std::size_t>(size)});
     }
@@ -87,26 +125,63 @@ class SqliteBag {
 
  private:
   [[noreturn]] void Fail(const std::string& why) const {
+    if (db_ && StepBudgetUsedUp(db_.get())) {
+      throw std::invalid_argument(path_ + ": " + why +
+                                  ": reading needed more SQLite steps than a rosbag2 file of "
+                                  "this size can (hostile or damaged file)");
+    }
     const char* detail = db_ ? sqlite3_errmsg(db_.get()) : "out of memory";
     throw std::invalid_argument(path_ + ": " + why + " (sqlite: " + detail + ")");
   }
 
+  [[noreturn]] void NotRosbag2(const std::string& why) const {
+    throw std::invalid_argument(path_ + ": not a rosbag2 sqlite3 file: " + why);
+  }
+
+  // topics and messages must be ordinary tables (a view or a virtual table would run a query or
+  // a module of the file's choosing) whose columns keyplace reads are stored, not generated.
   void CheckTables() {
-    Statement tables = Prepare(
-        "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN ('topics', "
-        "'messages')");
-    if (!Step(tables) || sqlite3_column_int(tables.get(), 0) != 2) {
-      throw std::invalid_argument(path_ +
-                                  ": not a rosbag2 sqlite3 file: it lacks the tables topics and "
-                                  "messages");
+    std::vector<std::pair<std::string, std::string>> objects;  // (type, sql) per required table
+    for (const RequiredTable& table : RequiredTables()) {
+      Statement object = Prepare("SELECT type, sql FROM sqlite_master WHERE name = ?");
+      sqlite3_bind_text(object.get(), 1, table.name, -1, SQLITE_STATIC);
+      if (!Step(object)) NotRosbag2("it lacks the tables topics and messages");
+      objects.emplace_back(Text(object, 0), Text(object, 1));
+    }
+    for (std::size_t k = 0; k < objects.size(); ++k) {
+      const auto& [type, sql] = objects[k];
+      const RequiredTable& table = RequiredTables()[k];
+      if (type != "table" || sql.rfind("CREATE TABLE", 0) != 0) {
+        NotRosbag2(std::string("'") + table.name + "' is a " +
+                   (type == "table" ? std::string("virtual table") : type) +
+                   ", not an ordinary table (a hostile or damaged file, not read further)");
+      }
+      CheckColumns(table);
     }
   }
 
-  Statement Prepare(const char* sql) {
+  void CheckColumns(const RequiredTable& table) {
+    std::map<std::string, int> hidden;  // column name -> 0 stored, 1 hidden, 2/3 generated
+    Statement columns = Prepare(std::string("PRAGMA table_xinfo(") + table.name + ")");
+    while (Step(columns)) hidden[Text(columns, 1)] = sqlite3_column_int(columns.get(), 6);
+    for (const char* column : table.columns) {
+      const auto found = hidden.find(column);
+      if (found == hidden.end()) {
+        NotRosbag2(std::string("table ") + table.name + " has no column " + column);
+      }
+      if (found->second != 0) {
+        NotRosbag2(std::string("column ") + table.name + "." + column +
+                   " is hidden or generated, not stored (a hostile or damaged file, not read "
+                   "further)");
+      }
+    }
+  }
+
+  Statement Prepare(const std::string& sql) {
     sqlite3_stmt* raw = nullptr;
-    if (sqlite3_prepare_v2(db_.get(), sql, -1, &raw, nullptr) != SQLITE_OK) {
+    if (sqlite3_prepare_v2(db_.get(), sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) {
       sqlite3_finalize(raw);
-      Fail(std::string("not a rosbag2 sqlite3 file: cannot run '") + sql + "'");
+      Fail("not a rosbag2 sqlite3 file: cannot run '" + sql + "'");
     }
     return Statement(raw);
   }
@@ -118,12 +193,13 @@ class SqliteBag {
     Fail("cannot read the database");
   }
 
-  std::string Text(const Statement& statement, int column) const {
+  static std::string Text(const Statement& statement, int column) {
     const unsigned char* text = sqlite3_column_text(statement.get(), column);
     return text == nullptr ? std::string() : reinterpret_cast<const char*>(text);
   }
 
   const std::string& path_;
+  StepBudget budget_;  // before db_: the connection's progress handler points at it
   Database db_;
 };
 

@@ -15,29 +15,21 @@
 #include <utility>
 #include <vector>
 
+#include "io/sqlite_hardening.hpp"
 #include "io/sqlite_magic.hpp"
 #include "store/map_schema.hpp"
 
 namespace keyplace {
 namespace {
 
-// SQLite calls the progress handler every this many virtual-machine instructions.
-constexpr int kInstructionsPerProgressCall = 1000;
-// Instructions a load may spend per byte of file, and at least: a safety net that ends a runaway
-// query should the schema check ever let one through. Loading the bundled FR079 map (1.5 MB)
-// takes 0.37 M instructions, 0.24 per byte (SQLite's integrity check is one instruction).
+// Instructions a load may spend per byte of file: loading the bundled FR079 map (1.5 MB) takes
+// 0.37 M instructions, 0.24 per byte (SQLite's integrity check is one instruction).
 constexpr std::uint64_t kInstructionsPerFileByte = 64;
-constexpr std::uint64_t kMinInstructions = 10'000'000;
 
 std::uint32_t BigEndian(const unsigned char* bytes, int count) {
   std::uint32_t value = 0;
   for (int k = 0; k < count; ++k) value = (value << 8) | bytes[k];
   return value;
-}
-
-int CountSteps(void* budget_pointer) {
-  auto* budget = static_cast<StepBudget*>(budget_pointer);
-  return ++budget->calls > budget->max_calls ? 1 : 0;
 }
 
 struct SchemaObject {
@@ -198,28 +190,10 @@ std::string ImmutableMapUri(const std::string& path) {
 // Settings made before the schema is first read, so that no part of a hostile file runs:
 // views and triggers disabled, functions in the schema untrusted, no writes, bounded values.
 void HardenMapConnection(Database& db, std::uint64_t file_bytes, StepBudget& budget) {
-  sqlite3* handle = db.get();
-  for (const auto& [option, value] :
-       {std::pair{SQLITE_DBCONFIG_ENABLE_VIEW, 0}, std::pair{SQLITE_DBCONFIG_ENABLE_TRIGGER, 0},
-        std::pair{SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0}, std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1},
-        std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0}}) {
-    if (sqlite3_db_config(handle, option, value, nullptr) != SQLITE_OK) {
-      db.Fail("cannot configure SQLite");
-    }
+  if (!HardenReadOnlyConnection(db.get(), file_bytes, 1'000'000'000, kInstructionsPerFileByte,
+                                budget)) {
+    db.Fail("cannot configure SQLite");
   }
-  // No value read from a file can be longer than the file.
-  const auto max_length = static_cast<int>(
-      std::min<std::uint64_t>(std::max<std::uint64_t>(file_bytes, 1 << 16), 1'000'000'000));
-  sqlite3_limit(handle, SQLITE_LIMIT_LENGTH, max_length);
-  sqlite3_limit(handle, SQLITE_LIMIT_ATTACHED, 0);
-  sqlite3_limit(handle, SQLITE_LIMIT_WORKER_THREADS, 0);
-  sqlite3_limit(handle, SQLITE_LIMIT_COLUMN, 100);
-  sqlite3_limit(handle, SQLITE_LIMIT_EXPR_DEPTH, 100);
-  sqlite3_limit(handle, SQLITE_LIMIT_COMPOUND_SELECT, 10);
-  budget.max_calls = std::max(kMinInstructions, kInstructionsPerFileByte * file_bytes) /
-                     kInstructionsPerProgressCall;
-  sqlite3_progress_handler(handle, kInstructionsPerProgressCall, CountSteps, &budget);
-  db.Execute("PRAGMA query_only = ON; PRAGMA trusted_schema = OFF; PRAGMA cell_size_check = ON;");
 }
 
 void CheckMapSchema(const Database& db) {

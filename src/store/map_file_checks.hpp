@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "io/sqlite_hardening.hpp"
 #include "store/sqlite_database.hpp"
 
 namespace keyplace {
@@ -23,14 +24,8 @@ MapFileFacts CheckMapFileHeader(const std::string& path);
 /// The URI that opens `path` read-only and immutable (with SQLITE_OPEN_READONLY | SQLITE_OPEN_URI).
 std::string ImmutableMapUri(const std::string& path);
 
-/// Counts SQLite's progress calls of one connection; past max_calls every statement stops.
-struct StepBudget {
-  std::uint64_t calls = 0;
-  std::uint64_t max_calls = 0;
-};
-
-/// Before the schema is first read: views, triggers and untrusted functions off, no writes, no
-/// value longer than the file, and a step budget proportional to the file size.
+/// Before the schema is first read: HardenReadOnlyConnection with no value longer than the file
+/// and 64 steps per byte of file.
 void HardenMapConnection(Database& db, std::uint64_t file_bytes, StepBudget& budget);
 
 /// sqlite_master holds exactly the tables SaveMap writes (ordinary tables, their columns and

@@ -299,6 +299,77 @@ TEST(Ros2Bag, AnSqliteFileWithoutRosbag2TablesIsAnError) {
   ExpectContains(ErrorOf(file), file + ": not a rosbag2 sqlite3 file: it lacks the tables");
 }
 
+// A database file made by `sql`, as a hostile or damaged bag might be.
+std::string SqliteFileOf(const std::string& name, const char* sql) {
+  const std::string file = testing::MakeTempDir("ros2sqlite") + "/" + name;
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  sqlite3_close(db);
+  return file;
+}
+
+constexpr const char* kTopicsTable =
+    "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
+    "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
+    "INSERT INTO topics VALUES (1, '/scan', 'sensor_msgs/msg/LaserScan', 'cdr', '');";
+
+// An endless recursive view in place of the messages table: reading it would never end (and
+// fill the temp directory sorting it). It must be refused without being run.
+TEST(Ros2Bag, MessagesAsAnEndlessViewIsRefusedUnrun) {
+  const std::string sql =
+      std::string(kTopicsTable) +
+      "CREATE VIEW messages AS WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n) "
+      "SELECT i AS id, 1 AS topic_id, i AS timestamp, zeroblob(1000) AS data FROM n "
+      "ORDER BY i DESC;";
+  const std::string file = SqliteFileOf("view.db3", sql.c_str());
+  ExpectContains(ErrorOf(file), file +
+                                    ": not a rosbag2 sqlite3 file: 'messages' is a view, not an "
+                                    "ordinary table (a hostile or damaged file, not read further)");
+}
+
+// A generated data column would make every blob whatever the file says, e.g. 200 MB of zeros.
+TEST(Ros2Bag, AGeneratedDataColumnIsRefused) {
+  const std::string sql =
+      std::string(kTopicsTable) +
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp "
+      "INTEGER NOT NULL, data BLOB GENERATED ALWAYS AS (zeroblob(200000000)) VIRTUAL);"
+      "INSERT INTO messages (topic_id, timestamp) VALUES (1, 5);";
+  const std::string file = SqliteFileOf("generated.db3", sql.c_str());
+  ExpectContains(ErrorOf(file), file +
+                                    ": not a rosbag2 sqlite3 file: column messages.data is hidden "
+                                    "or generated, not stored");
+}
+
+// rosbag2 plays messages by (timestamp, id), whatever order the rows were written in.
+TEST(Ros2Bag, MessagesAreReadInStampOrderWhateverTheRowOrder) {
+  const std::string bag = CopyFixture("sqlite3");
+  const std::string file = bag + "/sqlite3_0.db3";
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  // The rows in reverse: ids counted down, so the file order is against the time order.
+  ASSERT_EQ(sqlite3_exec(db,
+                         "CREATE TABLE reversed AS SELECT * FROM messages ORDER BY timestamp "
+                         "DESC, id DESC; DELETE FROM messages; INSERT INTO messages (topic_id, "
+                         "timestamp, data) SELECT topic_id, timestamp, data FROM reversed; DROP "
+                         "TABLE reversed; VACUUM;",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  const CarmenLog original = ReadRos2Bag(Fixture("sqlite3"));
+  const CarmenLog reversed = ReadRos2Bag(bag);
+  ASSERT_EQ(reversed.scans.size(), original.scans.size());
+  for (std::size_t k = 0; k < original.scans.size(); ++k) {
+    EXPECT_EQ(reversed.scans[k].timestamp_s, original.scans[k].timestamp_s) << k;
+    EXPECT_EQ(reversed.scans[k].ranges_m, original.scans[k].ranges_m) << k;
+    EXPECT_EQ(reversed.scans[k].odometry_pose->x, original.scans[k].odometry_pose->x) << k;
+  }
+  ASSERT_EQ(reversed.odometry.size(), original.odometry.size());
+  for (std::size_t k = 0; k < original.odometry.size(); ++k) {
+    EXPECT_EQ(reversed.odometry[k].timestamp_s, original.odometry[k].timestamp_s) << k;
+  }
+}
+
 // The same LaserScan in both byte orders (the fuzz seeds: one written by
 // @foxglove/rosmsg2-serialization, its fields byte-swapped by hand into the big-endian one).
 TEST(Ros2Cdr, BigAndLittleEndianMessagesDecodeAlike) {
