@@ -20,8 +20,9 @@
 //   mcap-tf/     MCAP, zstd chunks, odometry only on /tf (no /odom topic)
 //
 // `node generate_fixtures.mjs --seeds` also writes the fuzz seeds of tests/fuzz/corpus/mcap (the
-// first 4 scans cut to 24 beams, MCAP with 1 KiB chunks per compression) and
-// tests/fuzz/corpus/ros2_cdr (one CDR message of each type).
+// first 4 scans cut to 24 beams, MCAP with 1 KiB chunks per compression), tests/fuzz/corpus/ros2_sqlite
+// (the same 4 scans as sqlite3 storage, odometry on /odom or on /tf) and tests/fuzz/corpus/ros2_cdr
+// (one CDR message of each type).
 
 import fs from "node:fs";
 import path from "node:path";
@@ -236,11 +237,12 @@ async function writeMcap(dir, compression, tfOdometry) {
   fs.writeFileSync(path.join(dir, "metadata.yaml"), metadataYaml("mcap", file, messages));
 }
 
-// rosbag2's sqlite3 storage schema (version 3): topics and messages tables.
-async function writeSqlite(dir) {
-  const messages = messagesOf(false);
+// rosbag2's sqlite3 storage schema (version 3): topics and messages tables. The fuzz seeds use
+// 512-byte pages (SQLite's least) to keep them small.
+async function sqliteBytes(messages, pageBytes = 0) {
   const SQL = await initSqlJs();
   const db = new SQL.Database();
+  if (pageBytes > 0) db.run(`PRAGMA page_size = ${pageBytes}`);
   db.run("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL)");
   db.run("INSERT INTO schema VALUES (3, 'humble')");
   db.run("CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, " +
@@ -261,10 +263,16 @@ async function writeSqlite(dir) {
     insert.run([ids.get(m.topic), Number(m.logTime), writers[m.type].writeMessage(m.message)]);
   }
   insert.free();
+  const bytes = Buffer.from(db.export());
+  db.close();
+  return bytes;
+}
+
+async function writeSqlite(dir) {
+  const messages = messagesOf(false);
   const file = path.basename(dir) + "_0.db3";
   fs.mkdirSync(dir, { recursive: true });
-  fs.writeFileSync(path.join(dir, file), Buffer.from(db.export()));
-  db.close();
+  fs.writeFileSync(path.join(dir, file), await sqliteBytes(messages));
   fs.writeFileSync(path.join(dir, "metadata.yaml"), metadataYaml("sqlite3", file, messages));
 }
 
@@ -272,12 +280,17 @@ async function writeSeeds() {
   const fuzz = path.resolve(here, "../../fuzz/corpus");
   fs.mkdirSync(path.join(fuzz, "mcap"), { recursive: true });
   fs.mkdirSync(path.join(fuzz, "ros2_cdr"), { recursive: true });
+  fs.mkdirSync(path.join(fuzz, "ros2_sqlite"), { recursive: true });
   for (const compression of ["none", "lz4", "zstd"]) {
     const bytes = await mcapBytes(messagesOf(false, 4), compression, 1024);
     fs.writeFileSync(path.join(fuzz, "mcap", `fr079-4-scans-${compression}.mcap`), bytes);
   }
   fs.writeFileSync(path.join(fuzz, "mcap", "fr079-4-scans-tf-zstd.mcap"),
                    await mcapBytes(messagesOf(true, 4), "zstd", 1024));
+  fs.writeFileSync(path.join(fuzz, "ros2_sqlite", "fr079-4-scans.db3"),
+                   await sqliteBytes(messagesOf(false, 4), 512));
+  fs.writeFileSync(path.join(fuzz, "ros2_sqlite", "fr079-4-scans-tf.db3"),
+                   await sqliteBytes(messagesOf(true, 4), 512));
   const seen = new Set();
   for (const m of messagesOf(false, 2).concat(messagesOf(true, 2))) {
     const name = m.type.split("/").pop() + (m.topic === "/tf_static" ? "-static" : "");
