@@ -11,7 +11,8 @@ packages=(
   libeigen3-dev libnanoflann-dev libceres-dev zlib1g-dev libsqlite3-dev sqlite3
   libcli11-dev libfmt-dev libspdlog-dev libtbb-dev libcairo2-dev libyaml-cpp-dev
   nlohmann-json3-dev pybind11-dev python3-dev
-  # ROS 1 bags: Debian's rosbag storage library, the message headers, the chunk codecs
+  # ROS 1 bags: the message headers and the chunk codecs; Debian's rosbag storage library is
+  # the tests' oracle and writes their bags (the library does not link it)
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libgeometry-msgs-dev
   libroslz4-dev libbz2-dev
   # ROS 2 bags: MCAP chunk codecs (LZ4 frames, zstd); sqlite3 and yaml-cpp are above
