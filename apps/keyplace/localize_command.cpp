@@ -198,6 +198,7 @@ void RunLocalize(const LocalizeOptions& options) {
   report.truth_is_map_log = truth_is_map_log;
   report.first_scan = inputs.first_scan;
   report.file_scans = inputs.file_scans;
+  report.skipped_lines = inputs.log.skipped_lines;
   report.evaluation = config.evaluation;
   report.place = config.place;
   report.summary = Summarize(records, rank_by);

@@ -191,6 +191,7 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["truth_is_map_log"] = r.truth_is_map_log;
   json["first_scan"] = r.first_scan;
   json["scans"] = r.log_scans;
+  json["skipped_lines"] = r.skipped_lines;
   json["n_pos_requested"] = r.n_requested;
   json["n_pos"] = s.n_pos;
   json["n_acc"] = s.n_acc;

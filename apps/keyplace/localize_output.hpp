@@ -30,7 +30,8 @@ struct LocalizeReport {
   bool truth_is_map_log = true;                          // TruthIsMapLog
   std::size_t first_scan = 0;                            // --scans: the queries' part of the log
   std::size_t file_scans = 0;
-  EvaluationConfig evaluation;  // revisit_radius_m, revisit_angle_deg
+  std::size_t skipped_lines = 0;  // malformed lines skipped with --skip-bad-lines
+  EvaluationConfig evaluation;    // revisit_radius_m, revisit_angle_deg
   PlaceRecognitionConfig place;
   LocalizationSummary summary;
   double preparation_seconds = 0.0;

@@ -112,6 +112,7 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   json["scans"] = inputs.log.scans.size();
   json["first_scan"] = inputs.first_scan;
   json["scans_in_log"] = inputs.file_scans;
+  json["skipped_lines"] = inputs.log.skipped_lines;
   json["compression"] = stats.compression;
   json["scans_per_submap"] = stats.scans_per_submap;
   json["keypoints_per_submap"] = stats.keypoints_per_submap;

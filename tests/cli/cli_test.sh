@@ -61,6 +61,7 @@ cp "$work/out" "$work/coarse-info.txt"
 check "info warns" grep -q "cannot order the scans" "$work/coarse-info.txt"
 fails_with "odometry refuses coarse stamps" "--order file" "$keyplace" odometry "$work/coarse.log"
 check "odometry --order file" "$keyplace" odometry "$work/coarse.log" --order file
+fails_with "slam refuses coarse stamps" "--order file" "$keyplace" slam "$work/coarse.log"
 
 fails_with "bad odometry --set value" "odometry.icp.kernel" "$keyplace" odometry "$log" \
   --set odometry.icp.kernel=gauss
@@ -142,10 +143,21 @@ check "info --skip-bad-lines" "$keyplace" info "$work/damaged.log" --skip-bad-li
   --json "$work/damaged.json"
 check "info: skipped line counted" test "$(json_value "$work/damaged.json" skipped_lines)" = 1
 check "info: scans around the skipped line" test "$(json_value "$work/damaged.json" scans)" = 600
-"$keyplace" map "$work/damaged.log" --skip-bad-lines >"$work/damaged.out" 2>"$work/damaged.err"
+"$keyplace" map "$work/damaged.log" --skip-bad-lines --json "$work/damaged-map.json" \
+  >"$work/damaged.out" 2>"$work/damaged.err"
 check "map --skip-bad-lines warns" grep -qF "skipped 1 malformed line (line 601)" "$work/damaged.err"
+check "map: skipped line counted" test "$(json_value "$work/damaged-map.json" skipped_lines)" = 1
 check "localize --skip-bad-lines" "$keyplace" localize --map "$work/map.kpm" \
-  --log "$work/damaged.log" --skip-bad-lines --n-pos 10
+  --log "$work/damaged.log" --skip-bad-lines --n-pos 10 --json "$work/damaged-localize.json"
+check "localize: skipped line counted" \
+  test "$(json_value "$work/damaged-localize.json" skipped_lines)" = 1
+check "map: no line skipped" test "$(json_value "$work/map.json" skipped_lines)" = 0
+# More queries asked for than the log has starts: capped with a note, no start used twice.
+"$keyplace" localize --map "$work/map.kpm" --log "$log" --scans 0:40 --n-pos 500 \
+  --json "$work/capped.json" >/dev/null 2>"$work/capped.err"
+check "localize: --n-pos capped with a note" grep -qF "keyplace: note: --n-pos 500 capped to the" \
+  "$work/capped.err"
+check "localize: capped below the scans" test "$(json_value "$work/capped.json" n_pos)" -lt 40
 fails_with "missing file" "does not exist" "$keyplace" info "$work/missing.log"
 fails_with "bad pose source" "--poses" "$keyplace" map "$log" --poses gps
 fails_with "bad --set key" "unknown configuration key 'mapping.no_such'" "$keyplace" map "$log" \
