@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -18,6 +19,7 @@
 
 #include "io/ros2_storage.hpp"
 #include "io/sqlite_hardening.hpp"
+#include "io/sqlite_magic.hpp"
 
 namespace keyplace {
 namespace {
@@ -71,6 +73,7 @@ class SqliteBag {
   explicit SqliteBag(const std::string& path) : path_(path) {
     std::error_code error;
     const std::uint64_t file_bytes = std::filesystem::file_size(path, error);
+    if (!error) CheckNotCutOff(file_bytes);
     sqlite3* raw = nullptr;
     const int status = sqlite3_open_v2(FileUri(path).c_str(), &raw,
                                        SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
@@ -132,6 +135,26 @@ class SqliteBag {
     }
     const char* detail = db_ ? sqlite3_errmsg(db_.get()) : "out of memory";
     throw std::invalid_argument(path_ + ": " + why + " (sqlite: " + detail + ")");
+  }
+
+  // A recording cut short (a full disk, a power loss) leaves fewer pages than the header counts;
+  // SQLite would only say "malformed" at the first page missing. Its b-trees are not read in
+  // part.
+  void CheckNotCutOff(std::uint64_t file_bytes) const {
+    unsigned char header[kSqliteHeaderBytes] = {};
+    std::ifstream in(path_, std::ios::binary);
+    in.read(reinterpret_cast<char*>(header), sizeof header);
+    if (in.gcount() != static_cast<std::streamsize>(sizeof header)) return;  // SQLite says why
+    const SqliteHeaderSize size = ReadSqliteHeaderSize(header);
+    const std::uint64_t header_bytes = std::uint64_t{size.pages} * size.page_bytes;
+    if (header_bytes > file_bytes) {
+      throw std::invalid_argument(
+          path_ + ": cut off at byte " + std::to_string(file_bytes) +
+          ": its SQLite header counts " + std::to_string(size.pages) + " pages of " +
+          std::to_string(size.page_bytes) + " bytes (" + std::to_string(header_bytes) +
+          " bytes); an sqlite3 bag cut short cannot be read in part (a recording stopped by a "
+          "full disk or power loss: recover what SQLite can with `sqlite3 FILE .recover`)");
+    }
   }
 
   [[noreturn]] void NotRosbag2(const std::string& why) const {

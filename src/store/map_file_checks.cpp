@@ -26,12 +26,6 @@ namespace {
 // 0.37 M instructions, 0.24 per byte (SQLite's integrity check is one instruction).
 constexpr std::uint64_t kInstructionsPerFileByte = 64;
 
-std::uint32_t BigEndian(const unsigned char* bytes, int count) {
-  std::uint32_t value = 0;
-  for (int k = 0; k < count; ++k) value = (value << 8) | bytes[k];
-  return value;
-}
-
 struct SchemaObject {
   std::string type;
   std::string name;
@@ -130,15 +124,15 @@ MapFileFacts CheckMapFileHeader(const std::string& path) {
   MapFileFacts facts;
   facts.bytes = std::filesystem::file_size(path, error);
   if (error) throw std::runtime_error(path + ": cannot read the map file's size");
-  std::array<unsigned char, 100> header{};
+  std::array<unsigned char, kSqliteHeaderBytes> header{};
   std::ifstream in(path, std::ios::binary);
   in.read(reinterpret_cast<char*>(header.data()), header.size());
   if (in.gcount() != static_cast<std::streamsize>(header.size()) ||
       !StartsWithSqliteMagic(header.data(), header.size())) {
     throw std::runtime_error(path + ": not a keyplace map file (not an SQLite database)");
   }
-  const std::uint32_t page_field = BigEndian(&header[16], 2);
-  facts.page_bytes = page_field == 1 ? 65536 : page_field;
+  const SqliteHeaderSize header_size = ReadSqliteHeaderSize(header.data());
+  facts.page_bytes = header_size.page_bytes;
   if (facts.page_bytes < 512 || (facts.page_bytes & (facts.page_bytes - 1)) != 0) {
     throw std::runtime_error(path + ": damaged map file: page size " +
                              std::to_string(facts.page_bytes) + " in the SQLite header");
@@ -154,12 +148,8 @@ MapFileFacts CheckMapFileHeader(const std::string& path) {
         path + ": truncated or damaged map file: " + std::to_string(facts.bytes) +
         " bytes is not a whole number of " + std::to_string(facts.page_bytes) + "-byte pages");
   }
-  const std::uint32_t change_counter = BigEndian(&header[24], 4);
-  const std::uint32_t header_pages = BigEndian(&header[28], 4);
-  const std::uint32_t valid_for = BigEndian(&header[92], 4);
-  // The page count in the header is valid only when written with the current change counter.
-  if (valid_for == change_counter && header_pages != 0 &&
-      std::uint64_t{header_pages} * facts.page_bytes != facts.bytes) {
+  const std::uint32_t header_pages = header_size.pages;
+  if (header_pages != 0 && std::uint64_t{header_pages} * facts.page_bytes != facts.bytes) {
     throw std::runtime_error(path + ": truncated or damaged map file: its header counts " +
                              std::to_string(header_pages) + " pages of " +
                              std::to_string(facts.page_bytes) + " bytes, the file holds " +

@@ -341,6 +341,16 @@ TEST(Ros2Bag, AGeneratedDataColumnIsRefused) {
                                     "or generated, not stored");
 }
 
+// A recording cut short: the header counts more pages than the file holds.
+TEST(Ros2Bag, ACutSqliteFileIsAnErrorSayingSo) {
+  const std::string bag = CopyFixture("sqlite3");
+  const std::string file = bag + "/sqlite3_0.db3";
+  std::filesystem::resize_file(file, 300000);
+  ExpectContains(ErrorOf(bag), file +
+                                   ": cut off at byte 300000: its SQLite header counts 129 "
+                                   "pages of 4096 bytes (528384 bytes)");
+}
+
 // rosbag2 plays messages by (timestamp, id), whatever order the rows were written in.
 TEST(Ros2Bag, MessagesAreReadInStampOrderWhateverTheRowOrder) {
   const std::string bag = CopyFixture("sqlite3");
