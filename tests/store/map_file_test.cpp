@@ -2,9 +2,12 @@
 
 #include <sqlite3.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -197,6 +200,54 @@ TEST(MapFile, FailedSaveKeepsTheExistingFile) {
     ++files;
   }
   EXPECT_EQ(files, 1) << "temporary file left behind";
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Issue 18: a real kill -9 at any moment of a save leaves the previous map whole and loadable
+// (the new one is written to a temporary, synced and renamed over it), and the next save removes
+// the killed writer's temporary.
+TEST(MapFile, KillNineWhileSavingKeepsAWholeMap) {
+  const std::string dir = testing::MakeTempDir("mapfile");
+  const std::string path = dir + "/map.kpm";
+  const GlobalMap old_map = RandomMap(3, 5);
+  const GlobalMap new_map = RandomMap(60, 6);  // a few MB: each save takes a while
+  SaveMap(new_map, path);
+  const std::string new_bytes = FileBytes(path);
+  SaveMap(old_map, path);
+  const std::string old_bytes = FileBytes(path);
+  int kills_while_writing = 0;
+  for (const int delay_us : {0, 1000, 3000, 7000, 15000, 30000, 60000}) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      for (;;) SaveMap(new_map, path);  // until killed
+    }
+    usleep(static_cast<useconds_t>(delay_us));
+    ASSERT_EQ(kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+    const std::string bytes = FileBytes(path);
+    EXPECT_TRUE(bytes == old_bytes || bytes == new_bytes)
+        << "a kill after " << delay_us << " us left " << bytes.size() << " bytes";
+    EXPECT_NO_THROW(LoadMap(path)) << "a kill after " << delay_us << " us";
+    const std::string temporary = dir + "/.map.kpm.tmp" + std::to_string(child);
+    if (std::filesystem::exists(temporary)) ++kills_while_writing;
+  }
+  // The test is void unless some kill hit a save half-way.
+  EXPECT_GE(kills_while_writing, 3);
+  SaveMap(old_map, path);
+  EXPECT_EQ(FileBytes(path), old_bytes);
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++files;
+  }
+  EXPECT_EQ(files, 1) << "killed writers' temporaries left behind";
 }
 
 // ---------------------------------------------------------------------------------------------
