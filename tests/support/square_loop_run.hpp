@@ -79,14 +79,16 @@ struct SimulatedRun {
   std::vector<LogScan> scans;
 };
 
-inline SimulatedRun Simulate(double laps) {
+/// `range_noise_m`: the standard deviation of the range noise (0.005 m: a SICK LMS; a few
+/// centimetres: a cheaper scanner, whose keypoints recur less from scan to scan).
+inline SimulatedRun Simulate(double laps, double range_noise_m = 0.005) {
   SimulatedRun run;
   run.truth = SquareLoopPath(laps);
   const std::vector<Segment> world = SquareCorridorWorld();
   ScanOptions options;
   options.beams = 360;
   options.max_range_m = 15.0;
-  options.range_noise_m = 0.005;
+  options.range_noise_m = range_noise_m;
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 1.0);
   Pose2 odometry = run.truth.front();
