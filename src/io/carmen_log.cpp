@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "io/file_fingerprint.hpp"
+#include "io/ros2_storage.hpp"
 #include "io/sqlite_magic.hpp"
 #include "keyplace/io/ros1_bag.hpp"
 #include "keyplace/io/ros2_bag.hpp"
@@ -53,17 +54,21 @@ class LineReader {
     EnsureRaw(kSqliteMagic.size());
     if (StartsWithSqliteMagic(raw_.data(), raw_end_)) {
       throw std::invalid_argument(
-          path + ": an SQLite database (a keyplace map file?), not a CARMEN log" +
-          (regular_ ? "" : "; map files must be regular files, not pipes or devices"));
+          path + ": an SQLite database (a keyplace map file or a rosbag2 sqlite3 file?), not a " +
+          "CARMEN log" +
+          (regular_ ? "" : "; map files must be regular files (bags too), not pipes or devices"));
     }
+    // A regular file never gets past these two (ReadCarmenLog hands bags to their readers).
     static constexpr std::string_view kBagMagic = "#ROSBAG V2.0\n";
-    EnsureRaw(kBagMagic.size());
-    if (raw_end_ >= kBagMagic.size() &&
-        std::memcmp(raw_.data(), kBagMagic.data(), kBagMagic.size()) == 0) {
-      // A regular file never gets here (ReadCarmenLog hands it to ReadRos1Bag).
+    if (StartsWithRaw(kBagMagic)) {
       throw std::invalid_argument(path +
                                   ": a ROS 1 bag through a pipe or device: its reader seeks, " +
                                   "so give the bag as a regular file");
+    }
+    if (StartsWithRaw(kMcapMagic)) {
+      throw std::invalid_argument(path +
+                                  ": a ROS 2 MCAP file through a pipe or device: give the bag as "
+                                  "a regular file or a rosbag2 directory");
     }
     gzip_ = StartsWithGzipMagic();
     if (gzip_) StartInflating();
@@ -152,6 +157,11 @@ class LineReader {
     }
     while (raw_end_ < count && ReadRaw(raw_end_) > 0) {
     }
+  }
+
+  bool StartsWithRaw(std::string_view magic) {
+    EnsureRaw(magic.size());
+    return raw_end_ >= magic.size() && std::memcmp(raw_.data(), magic.data(), magic.size()) == 0;
   }
 
   bool StartsWithGzipMagic() const {

@@ -21,8 +21,8 @@
 namespace keyplace {
 namespace {
 
-constexpr char kMagic[] = "\x89MCAP0\r\n";
-constexpr std::size_t kMagicBytes = 8;
+constexpr const char* kMagic = kMcapMagic.data();
+constexpr std::size_t kMagicBytes = kMcapMagic.size();
 constexpr std::uint8_t kOpFooter = 0x02;
 constexpr std::uint8_t kOpSchema = 0x03;
 constexpr std::uint8_t kOpChannel = 0x04;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace keyplace {
@@ -34,6 +35,9 @@ struct StorageWalk {
   std::vector<std::string> warnings;  // what was dropped, naming the file and byte
   bool time_ordered = false;          // messages were visited in log time order
 };
+
+/// The 8 bytes an MCAP file starts (and ends) with.
+inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
 
 /// Whether the file starts with the MCAP magic bytes.
 bool StartsWithMcapMagic(const std::string& path);

@@ -105,8 +105,15 @@ all_figures="scans lines beams_total beams_per_scan_max field_of_view_deg line_c
     timeout $limit "$keyplace" info --check <(cat "$work/file.kpm")
   fails_with "localize with a map through a pipe" "map files must be regular files" \
     timeout $limit "$keyplace" localize --map <(cat "$work/file.kpm") --log "$log" --n-pos 5
-  fails_with "a map given as the log of map" "an SQLite database (a keyplace map file?)" \
+  fails_with "a map given as the log of map" "an SQLite database (a keyplace map file or" \
     timeout $limit "$keyplace" map "$work/file.kpm" --out "$work/other.kpm"
+
+  # Bags need seeking too: refused through a pipe with the reason, not read as a text log.
+  ros2="$source_dir/tests/data/ros2"
+  fails_with "an MCAP bag through a pipe" "a ROS 2 MCAP file through a pipe or device" \
+    timeout $limit "$keyplace" info <(cat "$ros2/mcap-zstd/mcap-zstd_0.mcap")
+  fails_with "an sqlite3 bag through a pipe" "map files must be regular files (bags too)" \
+    timeout $limit "$keyplace" info <(cat "$ros2/sqlite3/sqlite3_0.db3")
 }
 
 finish cli.pipes
