@@ -27,7 +27,7 @@ namespace {
 // A message larger than this is damage (a 10^5-beam scan is 400 kB).
 constexpr std::uint64_t kMaxBlobBytes = 256U << 20U;
 // Reading the fixture bag (528 kB, 450 messages) takes about 0.05 instructions per byte; a
-// bag's messages are read once, by their rowid.
+// bag's messages are read once, by their id.
 constexpr std::uint64_t kInstructionsPerFileByte = 64;
 
 struct CloseDatabase {
@@ -64,7 +64,7 @@ struct RequiredTable {
 const std::vector<RequiredTable>& RequiredTables() {
   static const std::vector<RequiredTable> tables = {
       {"topics", {"id", "name", "type", "serialization_format"}},
-      {"messages", {"topic_id", "timestamp", "data"}}};
+      {"messages", {"id", "topic_id", "timestamp", "data"}}};
   return tables;
 }
 
@@ -73,20 +73,25 @@ class SqliteBag {
   explicit SqliteBag(const std::string& path) : path_(path) {
     std::error_code error;
     const std::uint64_t file_bytes = std::filesystem::file_size(path, error);
-    if (!error) CheckNotCutOff(file_bytes);
+    if (error) {
+      throw std::invalid_argument(path + ": cannot read the size of the sqlite3 file (" +
+                                  error.message() + ")");
+    }
+    CheckHeader(file_bytes);
     sqlite3* raw = nullptr;
     const int status = sqlite3_open_v2(FileUri(path).c_str(), &raw,
                                        SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
     db_.reset(raw);
     if (status != SQLITE_OK) Fail("cannot open the sqlite3 file");
-    if (!HardenReadOnlyConnection(db_.get(), error ? 0 : file_bytes, kMaxBlobBytes,
-                                  kInstructionsPerFileByte, budget_)) {
+    if (!HardenReadOnlyConnection(db_.get(), file_bytes, kMaxBlobBytes, kInstructionsPerFileByte,
+                                  budget_)) {
       Fail("cannot configure SQLite");
     }
   }
 
   StorageWalk Walk(const StorageVisitor& visitor) {
     CheckTables();
+    CheckPages();
     StorageWalk walk;
     walk.time_ordered = true;
     std::map<sqlite3_int64, StorageTopic> topics;
@@ -98,20 +103,21 @@ class SqliteBag {
       topics[sqlite3_column_int64(topic_rows.get(), 0)] = std::move(topic);
     }
     // Messages in (timestamp, id) order, the order rosbag2 plays them. The order is made here
-    // from the stamps and rowids alone (16 bytes a message) rather than by SQLite's sorter, which
-    // would copy every blob into temporary files; each blob is then read once by its rowid.
-    std::vector<std::pair<sqlite3_int64, sqlite3_int64>> order;  // (timestamp, rowid)
-    Statement stamps = Prepare("SELECT timestamp, rowid FROM messages");
+    // from the stamps and ids alone (16 bytes a message) rather than by SQLite's sorter, which
+    // would copy every blob into temporary files; each blob is then read by its id, the table's
+    // primary key (CheckColumns), once: CheckPages made sure no two rows share a page.
+    std::vector<std::pair<sqlite3_int64, sqlite3_int64>> order;  // (timestamp, id)
+    Statement stamps = Prepare("SELECT timestamp, id FROM messages");
     while (Step(stamps)) {
       order.emplace_back(sqlite3_column_int64(stamps.get(), 0),
                          sqlite3_column_int64(stamps.get(), 1));
     }
     std::sort(order.begin(), order.end());
-    Statement message = Prepare("SELECT topic_id, data FROM messages WHERE rowid = ?");
-    for (const auto& [stamp_ns, rowid] : order) {
+    Statement message = Prepare("SELECT topic_id, data FROM messages WHERE id = ?");
+    for (const auto& [stamp_ns, id] : order) {
       sqlite3_reset(message.get());
-      sqlite3_bind_int64(message.get(), 1, rowid);
-      if (!Step(message)) Fail("message row " + std::to_string(rowid) + " vanished");
+      sqlite3_bind_int64(message.get(), 1, id);
+      if (!Step(message)) Fail("message id " + std::to_string(id) + " vanished");
       const sqlite3_int64 topic_id = sqlite3_column_int64(message.get(), 0);
       const auto topic = topics.find(topic_id);
       if (topic == topics.end()) {
@@ -137,15 +143,24 @@ class SqliteBag {
     throw std::invalid_argument(path_ + ": " + why + " (sqlite: " + detail + ")");
   }
 
-  // A recording cut short (a full disk, a power loss) leaves fewer pages than the header counts;
-  // SQLite would only say "malformed" at the first page missing. Its b-trees are not read in
-  // part.
-  void CheckNotCutOff(std::uint64_t file_bytes) const {
+  // What the 100-byte header says, before SQLite reads anything: a recording cut short (a full
+  // disk, a power loss) leaves fewer pages than the header counts, and SQLite would only say
+  // "malformed" at the first page missing (its b-trees are not read in part); a write-ahead-log
+  // file beside the bag holds messages the file does not, which an immutable read would drop.
+  void CheckHeader(std::uint64_t file_bytes) const {
     unsigned char header[kSqliteHeaderBytes] = {};
     std::ifstream in(path_, std::ios::binary);
     in.read(reinterpret_cast<char*>(header), sizeof header);
-    if (in.gcount() != static_cast<std::streamsize>(sizeof header)) return;  // SQLite says why
+    if (in.gcount() != static_cast<std::streamsize>(sizeof header) ||
+        !StartsWithSqliteMagic(header, sizeof header)) {
+      return;  // not SQLite: SQLite says so
+    }
     const SqliteHeaderSize size = ReadSqliteHeaderSize(header);
+    if (size.page_bytes < 512 || size.page_bytes > 65536 ||
+        (size.page_bytes & (size.page_bytes - 1)) != 0) {
+      throw std::invalid_argument(path_ + ": damaged sqlite3 file: page size " +
+                                  std::to_string(size.page_bytes) + " in its SQLite header");
+    }
     const std::uint64_t header_bytes = std::uint64_t{size.pages} * size.page_bytes;
     if (header_bytes > file_bytes) {
       throw std::invalid_argument(
@@ -154,6 +169,27 @@ class SqliteBag {
           std::to_string(size.page_bytes) + " bytes (" + std::to_string(header_bytes) +
           " bytes); an sqlite3 bag cut short cannot be read in part (a recording stopped by a "
           "full disk or power loss: recover what SQLite can with `sqlite3 FILE .recover`)");
+    }
+    constexpr unsigned char kWriteAheadLog = 2;
+    std::error_code error;
+    const std::string wal = path_ + "-wal";
+    if (header[18] == kWriteAheadLog && std::filesystem::is_regular_file(wal, error) &&
+        std::filesystem::file_size(wal, error) > 0 && !error) {
+      throw std::invalid_argument(
+          path_ + ": its write-ahead log " + wal +
+          " holds messages not yet in the file (a recording that did not end cleanly); open the "
+          "bag once with sqlite3 (`sqlite3 FILE 'PRAGMA wal_checkpoint;'`) to move them into it");
+    }
+  }
+
+  // Pages shared by two rows (or cycles of overflow pages) cost no SQLite steps to follow, so the
+  // step budget cannot bound them: a 10 MB file could make every small row point at the same
+  // blob as long as the file. quick_check finds them, in one pass over the file.
+  void CheckPages() {
+    Statement check = Prepare("PRAGMA quick_check(1)");
+    if (!Step(check) || Text(check, 0) != "ok") {
+      throw std::invalid_argument(path_ + ": damaged sqlite3 file: SQLite's quick_check says '" +
+                                  Text(check, 0) + "' (a hostile or damaged file, not read)");
     }
   }
 
@@ -183,20 +219,36 @@ class SqliteBag {
     }
   }
 
+  struct ColumnFacts {
+    int hidden = 0;       // 0 stored, 1 hidden, 2/3 generated
+    int primary_key = 0;  // position in the primary key, 0 if not in it
+  };
+
   void CheckColumns(const RequiredTable& table) {
-    std::map<std::string, int> hidden;  // column name -> 0 stored, 1 hidden, 2/3 generated
-    Statement columns = Prepare(std::string("PRAGMA table_xinfo(") + table.name + ")");
-    while (Step(columns)) hidden[Text(columns, 1)] = sqlite3_column_int(columns.get(), 6);
+    std::map<std::string, ColumnFacts> columns;
+    int primary_key_columns = 0;
+    Statement rows = Prepare(std::string("PRAGMA table_xinfo(") + table.name + ")");
+    while (Step(rows)) {
+      const ColumnFacts facts{sqlite3_column_int(rows.get(), 6), sqlite3_column_int(rows.get(), 5)};
+      columns[Text(rows, 1)] = facts;
+      primary_key_columns += facts.primary_key != 0 ? 1 : 0;
+    }
     for (const char* column : table.columns) {
-      const auto found = hidden.find(column);
-      if (found == hidden.end()) {
+      const auto found = columns.find(column);
+      if (found == columns.end()) {
         NotRosbag2(std::string("table ") + table.name + " has no column " + column);
       }
-      if (found->second != 0) {
+      if (found->second.hidden != 0) {
         NotRosbag2(std::string("column ") + table.name + "." + column +
                    " is hidden or generated, not stored (a hostile or damaged file, not read "
                    "further)");
       }
+    }
+    // Each message is looked up by its id: it must be the whole primary key, as rosbag2 writes
+    // it, or every lookup would scan the table.
+    if (std::string(table.name) == "messages" &&
+        (columns.at("id").primary_key != 1 || primary_key_columns != 1)) {
+      NotRosbag2("messages.id is not the table's primary key");
     }
   }
 

@@ -351,6 +351,83 @@ TEST(Ros2Bag, ACutSqliteFileIsAnErrorSayingSo) {
                                    "pages of 4096 bytes (528384 bytes)");
 }
 
+// Two rows whose blobs share one chain of overflow pages read without any SQLite error and cost
+// no SQLite steps: a hostile file could make every small row as long as the file. quick_check
+// finds the shared page before any row is read.
+TEST(Ros2Bag, RowsSharingPagesAreRefusedBeforeAnyIsRead) {
+  const std::string sql =
+      std::string("PRAGMA page_size = 512;") + kTopicsTable +
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp "
+      "INTEGER NOT NULL, data BLOB NOT NULL);"
+      "INSERT INTO messages (topic_id, timestamp, data) VALUES (1, 5, "
+      "CAST(replace(hex(zeroblob(5057)), '00', 'A') AS BLOB)), (1, 6, "
+      "CAST(replace(hex(zeroblob(5057)), '00', 'B') AS BLOB));";
+  const std::string file = SqliteFileOf("shared.db3", sql.c_str());
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  // Each row keeps a few bytes of its blob in its cell, followed by the number of its first
+  // overflow page (big-endian); the overflow pages hold runs of ~500 bytes.
+  const auto first_overflow_page = [&](char marker) {
+    std::size_t run_start = std::string::npos;
+    for (std::size_t k = 0; k < bytes.size(); ++k) {
+      if (bytes[k] == marker) {
+        if (run_start == std::string::npos) run_start = k;
+      } else if (run_start != std::string::npos) {
+        const std::size_t run = k - run_start;
+        if (run >= 20 && run < 100) return k;  // the cell's local part ends here
+        run_start = std::string::npos;
+      }
+    }
+    ADD_FAILURE() << "no cell of the '" << marker << "' row found";
+    return std::size_t{0};
+  };
+  const std::size_t pointer_a = first_overflow_page('A');
+  const std::size_t pointer_b = first_overflow_page('B');
+  ASSERT_NE(pointer_a, pointer_b);
+  bytes.replace(pointer_b, 4, bytes.substr(pointer_a, 4));  // B's blob is now A's chain
+  {
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  ExpectContains(ErrorOf(file), file + ": damaged sqlite3 file: SQLite's quick_check says '");
+}
+
+TEST(Ros2Bag, MessagesWithoutAnIdPrimaryKeyAreRefused) {
+  const std::string sql =
+      std::string(kTopicsTable) +
+      "CREATE TABLE messages(id INTEGER, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, "
+      "data BLOB NOT NULL);";
+  const std::string file = SqliteFileOf("no-key.db3", sql.c_str());
+  ExpectContains(ErrorOf(file), file +
+                                    ": not a rosbag2 sqlite3 file: messages.id is not the "
+                                    "table's primary key");
+}
+
+// rosbag2's resilient storage preset writes in write-ahead-log mode: after a crash the messages
+// since the last checkpoint are only in FILE-wal, which an immutable read would silently drop.
+TEST(Ros2Bag, AWriteAheadLogBesideTheBagIsAnErrorSayingHowToMergeIt) {
+  const std::string bag = CopyFixture("sqlite3");
+  const std::string file = bag + "/sqlite3_0.db3";
+  const std::string copy = testing::MakeTempDir("ros2wal") + "/crashed.db3";
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "PRAGMA journal_mode = WAL; PRAGMA wal_autocheckpoint = 0; "
+                         "UPDATE messages SET timestamp = timestamp + 1 WHERE id = 1;",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  // Copied while the writer is still open: the state a crash leaves.
+  fs::copy_file(file, copy);
+  fs::copy_file(file + "-wal", copy + "-wal");
+  sqlite3_close(db);
+  ASSERT_GT(fs::file_size(copy + "-wal"), 0U);
+  ExpectContains(ErrorOf(copy), copy + ": its write-ahead log " + copy +
+                                    "-wal holds messages not yet in the file");
+}
+
 // rosbag2 plays messages by (timestamp, id), whatever order the rows were written in.
 TEST(Ros2Bag, MessagesAreReadInStampOrderWhateverTheRowOrder) {
   const std::string bag = CopyFixture("sqlite3");
