@@ -151,7 +151,9 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
 // scanner) keypoints jitter from scan to scan, and too few stay stable for a stable-keypoint
 // query to pass the gamma check at the default gamma_min: that detector finds no loop, the drift
 // stays. Queried with the keypoints of all the submap's scans (the default), the same run closes
-// its loops, each at the true relative pose, and the drift goes.
+// its loops, each at the true relative pose, and the drift goes. The counts belong to this
+// world's seeds (measured: stable / all-scan loops 4 / 10 at 5 mm and 2 cm of noise, 0 / 3 at
+// 4 cm, 0 / 0 at 6 cm): a change to FLIRT or to the place thresholds may move them.
 TEST(OnlineSlam, AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld) {
   const SimulatedRun run = Simulate(1.4, 0.04);
   const FlirtExtractor extractor;
