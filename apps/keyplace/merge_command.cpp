@@ -147,6 +147,7 @@ void RunMerge(const MergeCommandOptions& options) {
     log = ReadLogWithScans(options.log_path, ReadingOptions(config));
     truth = LoadGroundTruth(*log, 0, log->scans.size(), options.truth_path, options.index_path,
                             log->fingerprint);
+    CheckMergeTruthSource(a, b, log->fingerprint);
   }
   // The library names the maps by their logs; the user gave these files.
   const MergeResult result = [&] {

@@ -77,10 +77,14 @@ void CheckSource(const GlobalMap& map, const char* name, const std::string& log_
 
 }  // namespace
 
-MergeEvaluation EvaluateMerge(const GlobalMap& a, const GlobalMap& b, const MergeResult& result,
-                              const GroundTruth& truth, const std::string& log_hash) {
+void CheckMergeTruthSource(const GlobalMap& a, const GlobalMap& b, const std::string& log_hash) {
   CheckSource(a, "A", log_hash);
   CheckSource(b, "B", log_hash);
+}
+
+MergeEvaluation EvaluateMerge(const GlobalMap& a, const GlobalMap& b, const MergeResult& result,
+                              const GroundTruth& truth, const std::string& log_hash) {
+  CheckMergeTruthSource(a, b, log_hash);
   MergeEvaluation evaluation;
   evaluation.at_origins = Placement(FirstTruthScan(a, truth, "A"), FirstTruthScan(b, truth, "B"),
                                     result.T_a_b, result.T_a_b);

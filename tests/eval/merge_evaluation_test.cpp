@@ -166,6 +166,10 @@ TEST(MergeEvaluation, RefusesMapsOfAnotherLogAndMapsWithoutTruth) {
   } catch (const std::invalid_argument& error) {
     EXPECT_NE(std::string(error.what()).find("map B"), std::string::npos) << error.what();
   }
+  // The same check alone, before a merge: the maps' log, or no fingerprint to compare, pass.
+  EXPECT_THROW(CheckMergeTruthSource(a, b, "crc32:9:9"), std::invalid_argument);
+  EXPECT_NO_THROW(CheckMergeTruthSource(a, b, "crc32:1:2"));
+  EXPECT_NO_THROW(CheckMergeTruthSource(a, b, ""));
   // A recognition naming a submap the maps do not hold.
   result.recognitions = {Recognition(5, 0, Pose2(), true)};
   EXPECT_THROW(EvaluateMerge(a, b, result, Truth(20, {})), std::invalid_argument);

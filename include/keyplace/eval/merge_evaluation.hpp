@@ -53,6 +53,12 @@ struct MergeEvaluation {
   ErrorStats recognitions_alone_stats;         // ... and of their recognition_error
 };
 
+/// Throws std::invalid_argument when map A or B was made from another log than the one whose
+/// fingerprint is `log_hash` (CarmenLog::fingerprint): what EvaluateMerge checks first, to be
+/// called before the long merge. Maps without a fingerprint (older files) and an empty
+/// `log_hash` pass.
+void CheckMergeTruthSource(const GlobalMap& a, const GlobalMap& b, const std::string& log_hash);
+
 /// Evaluates `result` (MergeMaps(a, b, ...)) against `truth`: the corrected poses of the log both
 /// maps were made from, loaded for the whole file (first_scan 0) so that its scan numbers are the
 /// maps' scan indices (LoadGroundTruth(log, 0, file_scans, ...)). `log_hash`: the fingerprint of
