@@ -1,4 +1,4 @@
-// keyplace.Scan, keyplace.Log and read_log: CARMEN logs and ROS 1 bags through the library's
+// keyplace.Scan, keyplace.Log and read_log: CARMEN logs and ROS 1 and 2 bags through the library's
 // reader (io/carmen_log.hpp).
 
 #include <cmath>
@@ -116,7 +116,7 @@ void BindScan(py::module_& module) {
 void BindLog(py::module_& module) {
   py::class_<CarmenLog>(module, "Log", "A log or bag as the library reads it.")
       .def_readonly("path", &CarmenLog::path)
-      .def_readonly("format", &CarmenLog::format, "'CARMEN log' or 'ROS 1 bag'.")
+      .def_readonly("format", &CarmenLog::format, "'CARMEN log', 'ROS 1 bag' or 'ROS 2 bag'.")
       .def_readonly("corrected", &CarmenLog::corrected,
                     "True when the scans' poses are SLAM-corrected (Scan.corrected_pose).")
       .def_readonly("fingerprint", &CarmenLog::fingerprint, "'crc32:<hex>:<bytes>' of the file.")
@@ -180,8 +180,9 @@ void BindIo(py::module_& module) {
              py::arg("laser_pose") = py::none(), py::arg("skip_bad_lines") = false,
              py::arg("keep_beams") = true,
              "read_log(path, config=None, scan_topic=None, odom_topic=None, laser_pose=None, "
-             "skip_bad_lines=False, keep_beams=True) -> Log: a CARMEN log (.log, .log.gz) or a "
-             "ROS 1 bag. For bags, the topics and laser_pose (T_base_laser, [x, y, theta] or "
+             "skip_bad_lines=False, keep_beams=True) -> Log: a CARMEN log (.log, .log.gz), a "
+             "ROS 1 bag or a ROS 2 bag (rosbag2 directory, metadata.yaml, .mcap, .db3). For bags, "
+             "the topics and laser_pose (T_base_laser, [x, y, theta] or "
              "'x,y,theta') override the config's input section. Raises RuntimeError when the "
              "file cannot be read and ValueError naming file and line for malformed content or "
              "a file without laser scans.");

@@ -40,6 +40,11 @@ void BindPlaceMatch(py::module_& module) {
       .def_property_readonly(
           "estimated_pose", [](const PlaceMatch& m) { return PoseArray(m.estimated_pose); },
           "The estimated pose in the map frame (paper Eq. 9).")
+      .def_property_readonly(
+          "estimated_pose_covariance",
+          [](const PlaceMatch& m) { return CovarianceArray(m.estimated_pose_covariance); },
+          "3 x 3 covariance of estimated_pose over (x, y, theta), from the RANSAC inliers' "
+          "least-squares fit (docs/NAVIGATION.md).")
       .def_readonly("pairs", &PlaceMatch::pairs, "Unique descriptor pairs with the match.")
       .def_readonly("consensus", &PlaceMatch::consensus, "RANSAC consensus.")
       .def_readonly("gamma", &PlaceMatch::gamma, "Second verification (paper Eq. 10).")
@@ -142,6 +147,10 @@ void BindRelocalizer(py::module_& module) {
                     "Odometry distance since the last confirming answer (m).")
       .def_readonly("position_variance_m2", &RelocalizationUpdate::position_variance_m2)
       .def_readonly("heading_variance_rad2", &RelocalizationUpdate::heading_variance_rad2)
+      .def_property_readonly(
+          "covariance", [](const RelocalizationUpdate& u) { return CovarianceArray(u.covariance); },
+          "3 x 3 covariance of pose over (x, y, theta), derived from the matches (valid when "
+          "status is 'fixed').")
       .def_readonly("answer", &RelocalizationUpdate::answer,
                     "The GlobalLocalizer's answer with this scan, or None.")
       .def_readonly("confirmed", &RelocalizationUpdate::confirmed)

@@ -184,12 +184,11 @@ void BindGrid(py::module_& module) {
       "ValueError naming the file and field that is wrong, RuntimeError for a missing file.");
 }
 
-InitialPose MakeInitialPose(const py::object& pose, double position_variance_m2,
-                            double heading_variance_rad2, const std::string& frame_id) {
+InitialPose MakeInitialPose(const py::object& pose, const py::object& covariance,
+                            const std::string& frame_id) {
   InitialPose initial;
   initial.T_map_robot = ToPose(pose, "pose");
-  initial.position_variance_m2 = position_variance_m2;
-  initial.heading_variance_rad2 = heading_variance_rad2;
+  if (!covariance.is_none()) initial.covariance = ToCovariance(covariance, "covariance");
   initial.frame_id = frame_id;
   return initial;
 }
@@ -198,17 +197,19 @@ void BindInitialPose(py::module_& module) {
   py::class_<InitialPose>(
       module, "InitialPose",
       "A fix as a geometry_msgs/PoseWithCovarianceStamped for /initialpose (AMCL, nav2): the "
-      "robot's pose in the map frame with the fix filter's variances (docs/NAVIGATION.md).")
-      .def(py::init(&MakeInitialPose), py::arg("pose"), py::arg("position_variance_m2") = 0.0,
-           py::arg("heading_variance_rad2") = 0.0, py::arg("frame_id") = "map",
-           "InitialPose(pose, position_variance_m2=0.0, heading_variance_rad2=0.0, "
-           "frame_id='map'): pose is T_map_robot [x_m, y_m, theta_rad].")
+      "robot's pose in the map frame with a covariance derived from the matches "
+      "(docs/NAVIGATION.md).")
+      .def(py::init(&MakeInitialPose), py::arg("pose"), py::arg("covariance") = py::none(),
+           py::arg("frame_id") = "map",
+           "InitialPose(pose, covariance=None, frame_id='map'): pose is T_map_robot [x_m, y_m, "
+           "theta_rad], covariance a 3 x 3 array over (x, y, theta) (None: zeros).")
       .def_readonly("frame_id", &InitialPose::frame_id)
       .def_property_readonly(
           "pose", [](const InitialPose& p) { return PoseArray(p.T_map_robot); },
           "T_map_robot [x_m, y_m, theta_rad].")
-      .def_readonly("position_variance_m2", &InitialPose::position_variance_m2, "Of x and of y.")
-      .def_readonly("heading_variance_rad2", &InitialPose::heading_variance_rad2)
+      .def_property_readonly(
+          "pose_covariance", [](const InitialPose& p) { return CovarianceArray(p.covariance); },
+          "3 x 3 covariance over (x, y, theta) (m^2, m rad, rad^2).")
       .def_property_readonly(
           "covariance",
           [](const InitialPose& p) {
@@ -246,7 +247,7 @@ void BindInitialPose(py::module_& module) {
         return InitialPoseOf(u, frame_id);
       },
       py::arg("frame_id") = "map",
-      "initial_pose(frame_id='map') -> InitialPose: the fix with the filter's variances; "
+      "initial_pose(frame_id='map') -> InitialPose: the fix with its covariance; "
       "ValueError unless status is 'fixed'.");
 }
 

@@ -95,17 +95,20 @@ void BindRecords(py::module_& module) {
           "truth", [](const FixEvent& f) { return PoseArray(f.truth); },
           "True T_world_robot at checked_scan.")
       .def_property_readonly(
-          "pose_at_fix", [](const FixEvent& f) { return PoseArray(f.T_world_robot_at_fix); },
+          "pose_at_fix", [](const FixEvent& f) { return PoseArray(f.initial_pose.T_map_robot); },
           "T_world_robot as reported at `scan` (what a robot publishes).")
       .def_readonly("confidence", &FixEvent::confidence)
-      .def_readonly("position_variance_m2", &FixEvent::position_variance_m2)
-      .def_readonly("heading_variance_rad2", &FixEvent::heading_variance_rad2)
       .def_readonly("correct", &FixEvent::correct, "Within 0.5 m and 10 deg of the truth.")
       .def_readonly("first", &FixEvent::first, "The start's first fix.")
       .def(
           "initial_pose",
-          [](const FixEvent& f, const std::string& frame_id) { return InitialPoseOf(f, frame_id); },
-          py::arg("frame_id") = "map", "The fix as the /initialpose message (InitialPose).");
+          [](const FixEvent& f, const std::string& frame_id) {
+            InitialPose pose = f.initial_pose;
+            pose.frame_id = frame_id;
+            return pose;
+          },
+          py::arg("frame_id") = "map",
+          "The fix as the /initialpose message (InitialPose), as reported at `scan`.");
 
   py::class_<StartRecord>(module, "StartRecord", "One start of the benchmark.")
       .def_readonly("start_scan", &StartRecord::start_scan)
@@ -197,7 +200,9 @@ void BindRelocalizationEvaluation(py::module_& module) {
           [](const PyRelocalization& r, const std::string& frame_id) -> py::object {
             const std::optional<FirstFix> first = FirstFixOf(r.records);
             if (!first) return py::none();
-            return py::cast(InitialPoseOf(first->fix, frame_id));
+            InitialPose pose = first->fix.initial_pose;
+            pose.frame_id = frame_id;
+            return py::cast(pose);
           },
           py::arg("frame_id") = "map",
           "The first fix as the /initialpose message (what `--initialpose` writes), or None.");

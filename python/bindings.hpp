@@ -57,6 +57,10 @@ std::function<void(std::size_t, std::size_t)> ToProgress(const py::object& progr
 py::array_t<double> PoseArray(const Pose2& pose);
 /// None for an empty optional, else PoseArray.
 py::object OptionalPoseArray(const std::optional<Pose2>& pose);
+/// 3 x 3 array of a covariance over (x, y, theta).
+py::array_t<double> CovarianceArray(const Eigen::Matrix3d& covariance);
+/// A covariance from a 3 x 3 array-like; throws ValueError naming `what` otherwise.
+Eigen::Matrix3d ToCovariance(const py::handle& value, const std::string& what);
 /// N x 3 array of [x, y, theta] rows.
 py::array_t<double> PosesArray(const std::vector<Pose2>& poses);
 /// A pose from any sequence of three numbers; throws ValueError naming `what` otherwise.

@@ -88,6 +88,28 @@ py::array_t<double> PoseArray(const Pose2& pose) {
   return array;
 }
 
+py::array_t<double> CovarianceArray(const Eigen::Matrix3d& covariance) {
+  py::array_t<double> array({py::ssize_t{3}, py::ssize_t{3}});
+  auto view = array.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < 3; ++i) {
+    for (py::ssize_t j = 0; j < 3; ++j) view(i, j) = covariance(i, j);
+  }
+  return array;
+}
+
+Eigen::Matrix3d ToCovariance(const py::handle& value, const std::string& what) {
+  const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!array || array.ndim() != 2 || array.shape(0) != 3 || array.shape(1) != 3) {
+    throw py::value_error(what + " must be a 3 x 3 array over (x, y, theta)");
+  }
+  const auto view = array.unchecked<2>();
+  Eigen::Matrix3d covariance;
+  for (py::ssize_t i = 0; i < 3; ++i) {
+    for (py::ssize_t j = 0; j < 3; ++j) covariance(i, j) = view(i, j);
+  }
+  return covariance;
+}
+
 py::object OptionalPoseArray(const std::optional<Pose2>& pose) {
   if (!pose) return py::none();
   return PoseArray(*pose);

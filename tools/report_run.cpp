@@ -72,8 +72,20 @@ ReportSummary RunReport(const ReportOptions& options, const std::string& program
   summary.index_path = (fs::path(options.out_dir) / "index.html").string();
   WriteFileAtomically(summary.index_path, [&](std::ostream& out) { out << page; });
   summary.page_bytes = page.size();
-  for (const StepOutcome& o : context.outcomes)
+  for (std::size_t i = 0; i < context.outcomes.size(); ++i) {
+    const StepOutcome& o = context.outcomes[i];
     summary.failed_steps += o.state == StepState::kFailed;
+    ReportStepSummary step;
+    step.id = context.steps[i].id;
+    step.state = o.state == StepState::kDone     ? "done"
+                 : o.state == StepState::kRan    ? "ran"
+                 : o.state == StepState::kFailed ? "failed"
+                                                 : "skipped";
+    step.command = CommandLine(context.steps[i]);
+    step.message = o.message;
+    step.seconds = o.seconds;
+    summary.steps.push_back(step);
+  }
   return summary;
 }
 

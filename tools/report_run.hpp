@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace keyplace::cli {
 
@@ -18,10 +19,20 @@ struct ReportOptions {
   std::size_t stability_scan = 100;            // first scan of the submap of Figures 6-7
 };
 
+/// What became of one step of the plan.
+struct ReportStepSummary {
+  std::string id;       // ReportStep::id
+  std::string state;    // "done" (before this run), "ran", "failed" or "skipped"
+  std::string command;  // CommandLine(step)
+  std::string message;  // why skipped / failed
+  double seconds = 0.0;
+};
+
 struct ReportSummary {
-  std::string index_path;        // OUT/index.html
-  std::size_t page_bytes = 0;    // its size
-  std::size_t failed_steps = 0;  // steps that failed (listed on the page)
+  std::string index_path;                // OUT/index.html
+  std::size_t page_bytes = 0;            // its size
+  std::size_t failed_steps = 0;          // steps that failed (listed on the page)
+  std::vector<ReportStepSummary> steps;  // every step of the plan, in order
 };
 
 /// Plans the report's steps, runs those not done yet with `program` (this keyplace executable),

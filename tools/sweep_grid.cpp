@@ -261,7 +261,18 @@ std::vector<std::vector<double>> SweepResults::SortedRows() const {
   return rows;
 }
 
+nlohmann::json SweepResults::Json() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return JsonLocked();
+}
+
 void SweepResults::WriteJsonLocked() const {
+  const nlohmann::json json = JsonLocked();
+  WriteFileAtomically((std::filesystem::path(dir_) / "results.json").string(),
+                      [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+}
+
+nlohmann::json SweepResults::JsonLocked() const {
   nlohmann::json json;
   json["sweep"] = identity_;
   json["parameters"] = parameter_columns_;
@@ -280,8 +291,7 @@ void SweepResults::WriteJsonLocked() const {
     rows.push_back(row);
   }
   json["rows"] = rows;
-  WriteFileAtomically((std::filesystem::path(dir_) / "results.json").string(),
-                      [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+  return json;
 }
 
 }  // namespace keyplace::cli

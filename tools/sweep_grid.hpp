@@ -45,6 +45,8 @@ class SweepResults {
   bool Has(const std::vector<double>& point) const;
   std::size_t size() const;
   void Add(const std::vector<double>& point, const std::vector<double>& values);
+  /// What results.json holds: {"sweep": identity, "parameters", "columns", "rows": [...]}.
+  nlohmann::json Json() const;
   /// All rows (parameters then values), sorted by point.
   std::vector<std::vector<double>> SortedRows() const;
   /// Rewrites results.csv with its rows sorted by point, as results.json is: rows are appended in
@@ -55,6 +57,7 @@ class SweepResults {
  private:
   void WriteCsvLocked();
   void WriteJsonLocked() const;
+  nlohmann::json JsonLocked() const;
 
   std::string dir_;
   nlohmann::json identity_;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +13,8 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/eval/merge_evaluation.hpp"
 #include "keyplace/localization/map_merge.hpp"
 #include "keyplace/store/map_file.hpp"
 
@@ -25,6 +28,9 @@ struct MergeCommandOptions {
   std::string map_b;
   std::string out_path;
   std::string json_path;
+  std::string log_path;    // the log both maps were made from: evaluate against its truth
+  std::string truth_path;  // a raw --log's corrected log, paired by --index
+  std::string index_path;
   ConfigOptions config;
 };
 
@@ -35,6 +41,68 @@ void PrintMerge(const MergeCommandOptions& options, const MergeResult& result) {
              result.recognitions.size(), result.queried, result.agreeing);
   fmt::print("merged map           {} submaps written to {}\n", result.merged.submaps.size(),
              options.out_path);
+}
+
+void PrintEvaluation(const MergeEvaluation& evaluation) {
+  const MergePlacementError& origins = evaluation.at_origins;
+  fmt::print(
+      "error at the origins  {:.3f} m, {:.3f} deg (B's scan {} seen from A's scan {}: the frames, "
+      "with both sessions' drift)\n",
+      origins.error.translation_m, origins.error.rotation_deg, origins.scan_b, origins.scan_a);
+  const ErrorStats& stats = evaluation.at_recognitions_stats;
+  fmt::print(
+      "error where they meet {:.3f} m, {:.3f} deg mean, {:.3f} m, {:.3f} deg max over {} agreeing "
+      "recognitions with truth poses ({} without)\n",
+      stats.translation_mean_m, stats.rotation_mean_deg, stats.translation_max_m,
+      stats.rotation_max_deg, stats.count, evaluation.recognitions_without_truth);
+  const ErrorStats& alone = evaluation.recognitions_alone_stats;
+  fmt::print(
+      "each recognition alone {:.3f} m, {:.3f} deg mean, {:.3f} m, {:.3f} deg max (its own "
+      "transform)\n",
+      alone.translation_mean_m, alone.rotation_mean_deg, alone.translation_max_m,
+      alone.rotation_max_deg);
+}
+
+nlohmann::json PlacementJson(const MergePlacementError& placement) {
+  return {{"scan_a", placement.scan_a},
+          {"scan_b", placement.scan_b},
+          {"submap_a", placement.submap_a},
+          {"submap_b", placement.submap_b},
+          {"true_T_a_scan_b",
+           {{"x_m", placement.true_T_a_scan_b.x},
+            {"y_m", placement.true_T_a_scan_b.y},
+            {"theta_rad", placement.true_T_a_scan_b.theta}}},
+          {"translation_error_m", placement.error.translation_m},
+          {"rotation_error_deg", placement.error.rotation_deg},
+          {"recognition_translation_error_m", placement.recognition_error.translation_m},
+          {"recognition_rotation_error_deg", placement.recognition_error.rotation_deg}};
+}
+
+nlohmann::json EvaluationJson(const MergeCommandOptions& options,
+                              const MergeEvaluation& evaluation) {
+  nlohmann::json json;
+  json["log"] = options.log_path;
+  json["truth"] = options.truth_path;
+  json["index"] = options.index_path;
+  json["at_origins"] = PlacementJson(evaluation.at_origins);
+  const ErrorStats& stats = evaluation.at_recognitions_stats;
+  json["at_recognitions"] = {{"count", stats.count},
+                             {"without_truth", evaluation.recognitions_without_truth},
+                             {"translation_mean_m", stats.translation_mean_m},
+                             {"translation_max_m", stats.translation_max_m},
+                             {"rotation_mean_deg", stats.rotation_mean_deg},
+                             {"rotation_max_deg", stats.rotation_max_deg}};
+  const ErrorStats& alone = evaluation.recognitions_alone_stats;
+  json["recognitions_alone"] = {{"translation_mean_m", alone.translation_mean_m},
+                                {"translation_max_m", alone.translation_max_m},
+                                {"rotation_mean_deg", alone.rotation_mean_deg},
+                                {"rotation_max_deg", alone.rotation_max_deg}};
+  nlohmann::json items = nlohmann::json::array();
+  for (const MergePlacementError& placement : evaluation.at_recognitions) {
+    items.push_back(PlacementJson(placement));
+  }
+  json["at_recognitions"]["items"] = items;
+  return json;
 }
 
 nlohmann::json MergeJson(const MergeCommandOptions& options, const MergeResult& result) {
@@ -63,11 +131,24 @@ nlohmann::json MergeJson(const MergeCommandOptions& options, const MergeResult& 
 
 void RunMerge(const MergeCommandOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--out", options.out_path}, {"--json", options.json_path}},
-               {options.map_a, options.map_b});
+  CheckOutputs(
+      {{"--out", options.out_path}, {"--json", options.json_path}},
+      {options.map_a, options.map_b, options.log_path, options.truth_path, options.index_path});
+  if (options.log_path.empty() && !(options.truth_path.empty() && options.index_path.empty())) {
+    throw std::invalid_argument("--truth and --index need --log (the log the maps were made from)");
+  }
   const Config config = ResolveConfig(options.config);
   const GlobalMap a = LoadMap(options.map_a);
   const GlobalMap b = LoadMap(options.map_b);
+  // The truth is read before the long part, so that a wrong file fails at once.
+  std::optional<CarmenLog> log;
+  std::optional<GroundTruth> truth;
+  if (!options.log_path.empty()) {
+    log = ReadLogWithScans(options.log_path, ReadingOptions(config));
+    truth = LoadGroundTruth(*log, 0, log->scans.size(), options.truth_path, options.index_path,
+                            log->fingerprint);
+    CheckMergeTruthSource(a, b, log->fingerprint);
+  }
   // The library names the maps by their logs; the user gave these files.
   const MergeResult result = [&] {
     try {
@@ -81,10 +162,14 @@ void RunMerge(const MergeCommandOptions& options) {
       throw std::invalid_argument(options.map_b + " into " + options.map_a + ": " + error.what());
     }
   }();
+  std::optional<MergeEvaluation> evaluation;
+  if (truth) evaluation = EvaluateMerge(a, b, result, *truth, log->fingerprint);
   SaveMap(result.merged, options.out_path);
   PrintMerge(options, result);
+  if (evaluation) PrintEvaluation(*evaluation);
   if (!options.json_path.empty()) {
     nlohmann::json json = MergeJson(options, result);
+    if (evaluation) json["evaluation"] = EvaluationJson(options, *evaluation);
     json["seconds_total"] = SecondsSince(start);
     json["config"] = ConfigJson(config);
     WriteJson(options.json_path, json);
@@ -112,7 +197,22 @@ void RegisterMergeCommand(CLI::App& app) {
   command->add_option("--out", options->out_path, "Write the merged map to this file (.kpm)")
       ->required();
   command->add_option("--json", options->json_path,
-                      "Write the transform and every recognition as JSON to FILE");
+                      "Write the transform and every recognition (and the evaluation, with "
+                      "--log) as JSON to FILE");
+  command
+      ->add_option("--log", options->log_path,
+                   "The log both maps were made from (e.g. its two halves): print the error of "
+                   "the transform against its corrected poses, at the maps' first scans and "
+                   "where the maps meet (docs/MERGE.md)")
+      ->check(CLI::ExistingPath);
+  command
+      ->add_option("--truth", options->truth_path,
+                   "Corrected log giving the ground truth of a raw --log")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--index", options->index_path,
+                   "raw_index<TAB>corrected_index file relating --log to --truth")
+      ->check(CLI::ExistingFile);
   // Joining maps acts on the answer as a robot would: the strict preset (see relocalize).
   options->config.preset = "strict";
   AddConfigOptions(command, options->config);

@@ -45,7 +45,7 @@ void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
     fmt::print(stderr, "keyplace: note: no start got a fix; {} not written\n", path);
     return;
   }
-  WriteInitialPose(InitialPoseOf(first->fix), path);
+  WriteInitialPose(first->fix.initial_pose, path);
   fmt::print("initial pose (first fix, start at scan {}, fix at scan {}) written to {}\n",
              first->start_scan, first->fix.scan, path);
 }
@@ -140,7 +140,8 @@ void RegisterRelocalizeCommand(CLI::App& app) {
   command->add_option("--json", options->json_path, "Write the summary as JSON to FILE");
   command->add_option("--tsv", options->tsv_path, "Write one TSV row per start to FILE");
   command->add_option("--fixes", options->fixes_path,
-                      "Write one TSV row per fix reported (pose, truth, error) to FILE");
+                      "Write one TSV row per fix reported (pose, truth, error, and the covariance "
+                      "over x, y, theta derived from the matches) to FILE");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
   command->add_option("--initialpose", options->initial_pose_path,

@@ -76,17 +76,20 @@ void WriteStartsTsv(const std::string& path, const std::vector<StartRecord>& rec
 void WriteFixesTsv(const std::string& path, const std::vector<StartRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "start_scan\tscan\tchecked_scan\tfirst\tcorrect\tconfidence\test_x\test_y\t"
-           "est_theta\ttrue_x\ttrue_y\ttrue_theta\terror_m\terror_deg\n";
+           "est_theta\ttrue_x\ttrue_y\ttrue_theta\terror_m\terror_deg\tcov_xx\tcov_xy\tcov_yy\t"
+           "cov_xtheta\tcov_ytheta\tcov_thetatheta\n";
     for (const StartRecord& r : records) {
       for (const FixEvent& f : r.fixes) {
         const Pose2 error = Between(f.truth, f.T_world_robot);
+        const Eigen::Matrix3d& c = f.initial_pose.covariance;  // at `scan`
         fmt::print(out,
                    "{}\t{}\t{}\t{:d}\t{:d}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}"
-                   "\t{:.3f}\t{:.2f}\n",
+                   "\t{:.3f}\t{:.2f}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\n",
                    r.start_scan, f.scan, f.checked_scan, f.first, f.correct, f.confidence,
                    f.T_world_robot.x, f.T_world_robot.y, f.T_world_robot.theta, f.truth.x,
                    f.truth.y, f.truth.theta, TranslationNorm(error),
-                   std::abs(error.theta) * 180.0 / M_PI);
+                   std::abs(error.theta) * 180.0 / M_PI, c(0, 0), c(0, 1), c(1, 1), c(0, 2),
+                   c(1, 2), c(2, 2));
       }
     }
   });

@@ -5,11 +5,14 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
 #include "commands.hpp"
 #include "report_run.hpp"
 
@@ -23,9 +26,41 @@ std::string DefaultDataDir() {
   return shared != nullptr ? (fs::path(shared) / "data").string() : std::string("../shared/data");
 }
 
-int Report(ReportOptions options) {
+// --json: what the report ran and where the page is.
+nlohmann::json ReportJson(const ReportOptions& options, const ReportSummary& summary) {
+  nlohmann::json json;
+  json["index"] = summary.index_path;
+  json["page_bytes"] = summary.page_bytes;
+  json["data"] = options.data_dir;
+  json["work"] =
+      options.work_dir.empty() ? (fs::path(options.out_dir) / "work").string() : options.work_dir;
+  json["datasets"] = options.datasets;
+  json["quick"] = options.quick;
+  json["no_run"] = options.no_run;
+  std::map<std::string, std::size_t> counts = {
+      {"done", 0}, {"ran", 0}, {"failed", 0}, {"skipped", 0}};
+  nlohmann::json steps = nlohmann::json::array();
+  for (const ReportStepSummary& step : summary.steps) {
+    ++counts[step.state];
+    steps.push_back({{"id", step.id},
+                     {"state", step.state},
+                     {"command", step.command},
+                     {"message", step.message},
+                     {"seconds", step.seconds}});
+  }
+  json["steps_total"] = summary.steps.size();
+  json["steps_done_before"] = counts["done"];
+  json["steps_ran"] = counts["ran"];
+  json["steps_failed"] = counts["failed"];
+  json["steps_skipped"] = counts["skipped"];
+  json["steps"] = steps;
+  return json;
+}
+
+int Report(ReportOptions options, const std::string& json_path) {
   const auto start = std::chrono::steady_clock::now();
   if (options.data_dir.empty()) options.data_dir = DefaultDataDir();
+  CheckOutputs({{"--json", json_path}}, {});
   // This very executable, even if its file is replaced by a rebuild while the report runs.
   const ReportSummary summary = RunReport(options, "/proc/self/exe");
   fmt::print(
@@ -35,6 +70,11 @@ int Report(ReportOptions options) {
       summary.failed_steps > 0
           ? fmt::format("; {} step(s) FAILED, see the page's command list", summary.failed_steps)
           : "");
+  if (!json_path.empty()) {
+    nlohmann::json json = ReportJson(options, summary);
+    json["seconds_total"] = SecondsSince(start);
+    WriteJson(json_path, json);
+  }
   return summary.failed_steps > 0 ? 1 : 0;
 }
 
@@ -42,6 +82,7 @@ int Report(ReportOptions options) {
 
 void RegisterReportCommand(CLI::App& app) {
   auto options = std::make_shared<ReportOptions>();
+  auto json_path = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
       "report",
       "Write DIR/index.html: one self-contained page with every figure (3-12) and table (II-X) "
@@ -53,6 +94,9 @@ void RegisterReportCommand(CLI::App& app) {
       ->required();
   command->add_option("--data", options->data_dir,
                       "Data sets directory (default: $KEYPLACE_SHARED/data, else ../shared/data)");
+  command->add_option("--json", *json_path,
+                      "Write what the report did as JSON to FILE: the page, and every step with "
+                      "its command and state (done before, ran, failed, skipped)");
   command->add_option("--work", options->work_dir,
                       "Work directory for artefacts (default OUT/work)");
   command
@@ -72,8 +116,8 @@ void RegisterReportCommand(CLI::App& app) {
       ->add_option("--stability-scan", options->stability_scan,
                    "First scan of the submap drawn in Figures 6-7")
       ->capture_default_str();
-  command->callback([options] {
-    const int status = Report(*options);
+  command->callback([options, json_path] {
+    const int status = Report(*options, *json_path);
     if (status != 0) throw CLI::RuntimeError(status);
   });
 }

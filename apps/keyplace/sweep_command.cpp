@@ -2,6 +2,7 @@
 // in parallel, resumable, one result row per grid point written as soon as it finishes. The
 // place sweep evaluates Algorithm 4 through the same library calls as keyplace localize.
 
+#include <chrono>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -26,6 +27,7 @@ struct SweepOptions {
   std::string log_path;
   std::string poses;
   std::string out_dir;
+  std::string json_path;
   std::string scans;
   ConfigOptions config;
   std::string s_min = "0.3";
@@ -104,6 +106,8 @@ Config ResolveSweepConfig(const SweepOptions& options) {
 }
 
 void RunSweepMapping(const SweepOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
   const std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                                    {"l_g", ParseValueList(options.l_g, "--lg")}};
   const std::vector<std::vector<double>> grid = ExpandGrid(axes);
@@ -128,9 +132,13 @@ void RunSweepMapping(const SweepOptions& options) {
         return MappingSweepRow(inputs, MappingConfigAt(config.mapping, point[0], point[1]));
       });
   PrintSweepSummary(results, grid.size(), computed, options.out_dir);
+  WriteSweepJson(options.json_path, results, grid.size(), computed, options.out_dir,
+                 SecondsSince(start));
 }
 
 void RunSweepPlace(const SweepOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
   if (options.n_pos < 1) throw std::invalid_argument("--n-pos must be >= 1");
   std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                              {"l_g", ParseValueList(options.l_g, "--lg")},
@@ -175,6 +183,8 @@ void RunSweepPlace(const SweepOptions& options) {
                                             PlaceConfigAt(config.place, point), rule, rank_by);
                      });
   PrintSweepSummary(results, grid.size(), computed, options.out_dir);
+  WriteSweepJson(options.json_path, results, grid.size(), computed, options.out_dir,
+                 SecondsSince(start));
 }
 
 void AddCommonOptions(CLI::App* command, SweepOptions& options) {
@@ -183,6 +193,9 @@ void AddCommonOptions(CLI::App* command, SweepOptions& options) {
                    "Directory of the results: sweep.json, results.csv, results.json; an "
                    "interrupted sweep in it is resumed")
       ->required();
+  command->add_option("--json", options.json_path,
+                      "Also write the results (as DIR/results.json, with the grid size and the "
+                      "points computed by this run) to FILE");
   command->add_option("--scans", options.scans, "Use only the scans A:B of the log");
   command->add_option("--s-min", options.s_min, "s_min values: A:B:STEP or V1,V2,...")
       ->capture_default_str();

@@ -54,6 +54,18 @@ std::size_t RunSweepPoints(
   return finished.load();
 }
 
+void WriteSweepJson(const std::string& json_path, const SweepResults& results,
+                    std::size_t grid_size, std::size_t computed, const std::string& out_dir,
+                    double seconds_total) {
+  if (json_path.empty()) return;
+  nlohmann::json json = results.Json();
+  json["out"] = out_dir;
+  json["grid_points"] = grid_size;
+  json["computed_now"] = computed;
+  json["seconds_total"] = seconds_total;
+  WriteJson(json_path, json);
+}
+
 void PrintSweepSummary(const SweepResults& results, std::size_t grid_size, std::size_t computed,
                        const std::string& out_dir) {
   fmt::print("{} rows in {}/results.csv and results.json ({} grid points, {} computed now)\n",

@@ -28,4 +28,10 @@ std::size_t RunSweepPoints(
 void PrintSweepSummary(const SweepResults& results, std::size_t grid_size, std::size_t computed,
                        const std::string& out_dir);
 
+/// --json FILE: what results.json holds, with the directory, the grid size, the points computed
+/// by this run and `seconds_total`. Nothing when `json_path` is empty.
+void WriteSweepJson(const std::string& json_path, const SweepResults& results,
+                    std::size_t grid_size, std::size_t computed, const std::string& out_dir,
+                    double seconds_total);
+
 }  // namespace keyplace::cli

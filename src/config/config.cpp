@@ -62,7 +62,11 @@ const ConfigFields<FixPolicy>& FixPolicyFields() {
         .Double("lost_after_m", &C::lost_after_m, "m",
                 "a fix no answer confirmed over this odometry distance is lost")
         .Double("contradiction_confidence", &C::contradiction_confidence, "",
-                "one accepted answer this confident contradicting the fix loses it at once");
+                "one accepted answer this confident contradicting the fix loses it at once")
+        .Double("map_sigma_m", &C::map_sigma_m, "m",
+                "the map's own position error, added to a fix's covariance from the matches")
+        .Double("map_sigma_deg", &C::map_sigma_deg, "deg",
+                "the map's own heading error, added likewise");
     return table;
   }();
   return fields;

@@ -171,9 +171,7 @@ class StartRun {
     fix.T_world_robot = update.T_world_odom * inputs_.poses[*checked];
     fix.truth = truth_.Pose(*checked);
     fix.confidence = update.confidence;
-    fix.T_world_robot_at_fix = update.T_world_robot;
-    fix.position_variance_m2 = update.position_variance_m2;
-    fix.heading_variance_rad2 = update.heading_variance_rad2;
+    fix.initial_pose = InitialPoseOf(update);
     fix.correct = Within(fix.T_world_robot, fix.truth, options_.correct_m, options_.correct_deg);
     fix.checked_scan = static_cast<int>(*checked);
     fix.first = first;
@@ -318,15 +316,6 @@ std::optional<FirstFix> FirstFixOf(const std::vector<StartRecord>& records) {
     }
   }
   return std::nullopt;
-}
-
-InitialPose InitialPoseOf(const FixEvent& fix, const std::string& frame_id) {
-  InitialPose pose;
-  pose.frame_id = frame_id;
-  pose.T_map_robot = fix.T_world_robot_at_fix;
-  pose.position_variance_m2 = fix.position_variance_m2;
-  pose.heading_variance_rad2 = fix.heading_variance_rad2;
-  return pose;
 }
 
 }  // namespace keyplace

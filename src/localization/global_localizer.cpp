@@ -49,6 +49,13 @@ void Validate(const FixPolicy& policy) {
   require_positive(policy.agree_deg, "agree_deg");
   require_positive(policy.window_m, "window_m");
   require_positive(policy.lost_after_m, "lost_after_m");
+  for (const auto& [value, name] :
+       {std::pair<double, const char*>{policy.map_sigma_m, "map_sigma_m"},
+        {policy.map_sigma_deg, "map_sigma_deg"}}) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument(std::string("FixPolicy.") + name + " must be >= 0 and finite");
+    }
+  }
   if (!(policy.agree_per_m >= 0.0) || !std::isfinite(policy.agree_per_m)) {
     throw std::invalid_argument("FixPolicy.agree_per_m must be >= 0 and finite");
   }

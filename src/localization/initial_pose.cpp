@@ -56,13 +56,14 @@ std::string MessageText(const InitialPose& pose, bool json) {
 }  // namespace
 
 std::array<double, 36> InitialPoseCovariance(const InitialPose& pose) {
-  constexpr std::size_t kX = 0;  // row-major indices of the x, y and yaw diagonal terms
-  constexpr std::size_t kY = 7;
-  constexpr std::size_t kYaw = 35;
+  constexpr std::array<std::size_t, 3> kAxis = {0, 1, 5};  // x, y, yaw among x y z roll pitch yaw
   std::array<double, 36> covariance{};
-  covariance[kX] = pose.position_variance_m2;
-  covariance[kY] = pose.position_variance_m2;
-  covariance[kYaw] = pose.heading_variance_rad2;
+  for (std::size_t row = 0; row < 3; ++row) {
+    for (std::size_t column = 0; column < 3; ++column) {
+      covariance[6 * kAxis[row] + kAxis[column]] =
+          pose.covariance(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(column));
+    }
+  }
   return covariance;
 }
 
@@ -74,8 +75,7 @@ InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string&
   InitialPose pose;
   pose.frame_id = frame_id;
   pose.T_map_robot = update.T_world_robot;
-  pose.position_variance_m2 = update.position_variance_m2;
-  pose.heading_variance_rad2 = update.heading_variance_rad2;
+  pose.covariance = update.covariance;
   return pose;
 }
 

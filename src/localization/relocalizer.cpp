@@ -60,6 +60,8 @@ void FixFilter::Reset() {
   fix_confidence_ = 0.0;
   fix_variance_m2_ = 0.0;
   confirmed_at_m_ = 0.0;
+  fix_covariance_.setZero();
+  fix_covariance_at_ = Pose2();
 }
 
 RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
@@ -71,7 +73,8 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
 
   RelocalizationUpdate update;
   if (answer && answer->found) {
-    const Hypothesis hypothesis{answer->T_world_odom, answer->confidence, odometry_m_};
+    const Hypothesis hypothesis{answer->T_world_odom, answer->confidence, odometry_m_,
+                                answer->match.estimated_pose_covariance, T_odom_robot};
     if (status_ == FixStatus::kFixed) {
       Track(hypothesis, T_odom_robot, update);
     } else {
@@ -97,8 +100,37 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
     update.position_variance_m2 = fix_variance_m2_ + drift_m * drift_m;
     update.heading_variance_rad2 = update.position_variance_m2 / answer_variance_m2 *
                                    answer_heading_sigma_rad * answer_heading_sigma_rad;
+    // The matches' covariance, carried here, plus the map's own error (not fused away: every
+    // answer in one place shares it).
+    update.covariance = FixCovarianceAt(T_odom_robot);
+    const double map_sigma_rad = policy_.map_sigma_deg * kRadPerDeg;
+    update.covariance(0, 0) += policy_.map_sigma_m * policy_.map_sigma_m;
+    update.covariance(1, 1) += policy_.map_sigma_m * policy_.map_sigma_m;
+    update.covariance(2, 2) += map_sigma_rad * map_sigma_rad;
   }
   return update;
+}
+
+// The fix's covariance holds at the robot's pose of its last confirmation; the robot has moved
+// by odometry since. Odometry taken as exact, a heading error d_theta of the fix moves the robot
+// now by d_theta times its displacement turned by 90 degrees (the lever arm); odometry's own
+// drift adds the allowance of the variances, (agree_per_m * distance)^2 per position coordinate
+// and the heading's share of it scaled as there.
+Eigen::Matrix3d FixFilter::FixCovarianceAt(const Pose2& T_odom_robot) const {
+  const Eigen::Vector2d moved_m = (T_world_odom_ * T_odom_robot).translation() -
+                                  (T_world_odom_ * fix_covariance_at_).translation();
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Identity();
+  jacobian(0, 2) = -moved_m.y();
+  jacobian(1, 2) = moved_m.x();
+  Eigen::Matrix3d covariance = jacobian * fix_covariance_ * jacobian.transpose();
+  const double drift_m = policy_.agree_per_m * (odometry_m_ - confirmed_at_m_);
+  const double answer_sigma_m = 0.5 * policy_.agree_m;
+  const double answer_heading_sigma_rad = 0.5 * policy_.agree_deg * kRadPerDeg;
+  const double heading_drift_rad = drift_m / answer_sigma_m * answer_heading_sigma_rad;
+  covariance(0, 0) += drift_m * drift_m;
+  covariance(1, 1) += drift_m * drift_m;
+  covariance(2, 2) += heading_drift_rad * heading_drift_rad;
+  return covariance;
 }
 
 void FixFilter::Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
@@ -114,7 +146,8 @@ void FixFilter::Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
 
 void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
                       RelocalizationUpdate& update) {
-  const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_};
+  const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_,
+                       FixCovarianceAt(T_odom_robot), T_odom_robot};
   if (!Agreeing({fix}, hypothesis, T_odom_robot).empty()) {
     Confirm(hypothesis, T_odom_robot);
     update.confirmed = true;
@@ -138,7 +171,9 @@ void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
 // The fix and the answer are two estimates of the robot's pose now: the fix carries the odometry
 // drift since its last confirmation, the answer its own error (agree_m / 2, one sigma). Their
 // weighted mean is the new fix; its variance never falls below that of four answers, so odometry
-// that drifts more than agree_per_m allows is still pulled back by the answers.
+// that drifts more than agree_per_m allows is still pulled back by the answers. The covariance
+// derived from the matches follows the same fusion: the new fix is (1 - w) fix + w answer, so for
+// independent errors its covariance is (1 - w)^2 C_fix + w^2 C_answer (whatever w is).
 void FixFilter::Confirm(const Hypothesis& answer, const Pose2& T_odom_robot) {
   const double answer_variance = 0.25 * policy_.agree_m * policy_.agree_m;
   const double drift_m = policy_.agree_per_m * (odometry_m_ - confirmed_at_m_);
@@ -146,6 +181,9 @@ void FixFilter::Confirm(const Hypothesis& answer, const Pose2& T_odom_robot) {
   const double weight = fix_variance / (fix_variance + answer_variance);
   const Pose2 fix_now = T_world_odom_ * T_odom_robot;
   const Pose2 answer_now = answer.T_world_odom * T_odom_robot;
+  fix_covariance_ = (1.0 - weight) * (1.0 - weight) * FixCovarianceAt(T_odom_robot) +
+                    weight * weight * answer.covariance;
+  fix_covariance_at_ = T_odom_robot;
   const Pose2 fused(fix_now.x + weight * (answer_now.x - fix_now.x),
                     fix_now.y + weight * (answer_now.y - fix_now.y),
                     fix_now.theta + weight * WrapAngle(answer_now.theta - fix_now.theta));
@@ -189,6 +227,8 @@ void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypoth
   status_ = FixStatus::kFixed;
   T_world_odom_ = latest.T_world_odom;  // the newest answer carries the least odometry drift
   fix_variance_m2_ = 0.25 * policy_.agree_m * policy_.agree_m;
+  fix_covariance_ = latest.covariance;
+  fix_covariance_at_ = latest.T_odom_robot;
   fix_confidence_ = CombinedConfidence(confidences);
   confirmed_at_m_ = odometry_m_;
   hypotheses_.clear();

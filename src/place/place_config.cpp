@@ -28,7 +28,9 @@ const ConfigFields<RansacConfig>& RansacConfigFields() {
         .Double("rigidity_m2", &C::rigidity_m2, "m^2", "FLIRTLib's rigidity pre-check of a sample")
         .Bool("refine", &C::refine,
               "least-squares refit on the inliers, kept when it scores better")
-        .Int("seed", &C::seed, "", "random seed, combined with the place id");
+        .Int("seed", &C::seed, "", "random seed, combined with the place id")
+        .Double("min_fit_sigma_m", &C::min_fit_sigma_m, "m",
+                "floor of the residual sigma in a match's covariance (l_g / sqrt(12))");
     return table;
   }();
   return fields;
@@ -146,6 +148,7 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.ransac.iterations >= 1, "ransac.iterations", "must be >= 1");
   Require(config.ransac.exhaustive_max_pairs >= 0, "ransac.exhaustive_max_pairs", "must be >= 0");
   Require(config.ransac.rigidity_m2 > 0.0, "ransac.rigidity_m2", "must be positive");
+  Require(config.ransac.min_fit_sigma_m >= 0.0, "ransac.min_fit_sigma_m", "must be >= 0");
   Require(config.verification_neighbours >= 0, "verification_neighbours", "must be >= 0");
   Require(config.min_consensus >= 2, "min_consensus", "must be >= 2");
   Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");

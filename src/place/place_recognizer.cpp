@@ -508,6 +508,10 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     result.verified = true;
     result.T_ref_cur = estimate.T_ref_cur;
     result.estimated_pose = place.T_world_place * estimate.T_ref_cur * query.T_first_evaluated;
+    result.estimated_pose_covariance = ComposedCovariance(
+        place.T_world_place, estimate.T_ref_cur, query.T_first_evaluated,
+        RigidFitCovariance(*reference_positions, *match_positions, estimate.inliers,
+                           estimate.T_ref_cur, config_.ransac.min_fit_sigma_m));
     result.score = SelectionScore(config_.score, consensus, gamma.gamma);
     match.verified_candidates.push_back(result);
     if (config_.selection == PlaceRecognitionConfig::Selection::kFirstVerified) break;
@@ -534,6 +538,7 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
     match.place_id = places_[best->place_index].id;
     match.T_ref_cur = best->T_ref_cur;
     match.estimated_pose = best->estimated_pose;
+    match.estimated_pose_covariance = best->estimated_pose_covariance;
     match.pairs = best->pairs;
     match.consensus = best->consensus;
     match.gamma = best->gamma;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "place/nearest_reference.hpp"
 
@@ -50,6 +52,55 @@ Pose2 FitRigidTransform(const std::vector<Eigen::Vector2d>& reference,
   const Eigen::Vector2d rotated(c * mean_cur.x() - s * mean_cur.y(),
                                 s * mean_cur.x() + c * mean_cur.y());
   return {mean_ref.x() - rotated.x(), mean_ref.y() - rotated.y(), angle};
+}
+
+Eigen::Matrix3d RigidFitCovariance(const std::vector<Eigen::Vector2d>& reference,
+                                   const std::vector<Eigen::Vector2d>& current,
+                                   const std::vector<std::pair<int, int>>& inliers,
+                                   const Pose2& T_ref_cur, double min_sigma_m) {
+  Eigen::Matrix3d undetermined =
+      Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()).asDiagonal();
+  if (inliers.size() < 2) return undetermined;
+  const double c = std::cos(T_ref_cur.theta);
+  const double s = std::sin(T_ref_cur.theta);
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // sum of J^T J
+  double squared_residuals = 0.0;
+  for (const auto& [current_index, reference_index] : inliers) {
+    if (current_index < 0 || reference_index < 0 ||
+        static_cast<std::size_t>(current_index) >= current.size() ||
+        static_cast<std::size_t>(reference_index) >= reference.size()) {
+      throw std::invalid_argument("RigidFitCovariance: pair (" + std::to_string(current_index) +
+                                  ", " + std::to_string(reference_index) + ") out of range");
+    }
+    const Eigen::Vector2d& p = current[static_cast<std::size_t>(current_index)];
+    squared_residuals +=
+        (T_ref_cur * p - reference[static_cast<std::size_t>(reference_index)]).squaredNorm();
+    Eigen::Matrix<double, 2, 3> jacobian;
+    jacobian << 1.0, 0.0, -s * p.x() - c * p.y(),  // d(R p)/dtheta
+        0.0, 1.0, c * p.x() - s * p.y();
+    information += jacobian.transpose() * jacobian;
+  }
+  const double dof = 2.0 * static_cast<double>(inliers.size()) - 3.0;
+  const double variance = std::max(squared_residuals / dof, min_sigma_m * min_sigma_m);
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(information);
+  if (!lu.isInvertible()) return undetermined;
+  return variance * lu.inverse();
+}
+
+Eigen::Matrix3d ComposedCovariance(const Pose2& T_a_b, const Pose2& T_b_c, const Pose2& T_c_d,
+                                   const Eigen::Matrix3d& covariance_b_c) {
+  const double ca = std::cos(T_a_b.theta);
+  const double sa = std::sin(T_a_b.theta);
+  Eigen::Matrix2d R_ab;
+  R_ab << ca, -sa, sa, ca;
+  // d(R_bc t_cd)/dtheta_bc: R_bc t_cd turned by 90 degrees.
+  const Eigen::Vector2d arm = T_b_c * T_c_d.translation() - T_b_c.translation();
+  const Eigen::Vector2d d_arm(-arm.y(), arm.x());
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
+  jacobian.topLeftCorner<2, 2>() = R_ab;
+  jacobian.topRightCorner<2, 1>() = R_ab * d_arm;
+  jacobian(2, 2) = 1.0;
+  return jacobian * covariance_b_c * jacobian.transpose();
 }
 
 namespace {

@@ -173,6 +173,21 @@ check "dump-config" "$keyplace" dump-config
 check "dump-config round trip" cmp "$work/defaults.yaml" "$work/defaults-again.yaml"
 "$keyplace" dump-config --preset paper >"$work/paper.yaml"
 check "paper preset differs" grep -q "^  selection: first_verified" "$work/paper.yaml"
+# dump-config --json: the configuration the YAML shows, as the "config" object of other commands'
+# JSON, --set applied.
+check "dump-config --json" "$keyplace" dump-config --set place.ransac.iterations=40 \
+  --json "$work/config.json"
+check "dump-config --json is the YAML's configuration" /usr/bin/python3 -c "
+import json, sys, yaml
+j = json.load(open(sys.argv[1]))
+assert j['place']['ransac']['iterations'] == '40', j['place']['ransac']
+# Values as the YAML writes them (text, as the config object of every --json).
+defaults = yaml.load(open(sys.argv[2]), Loader=yaml.BaseLoader)
+defaults['place']['ransac']['iterations'] = '40'
+assert j == defaults, [k for k in j if j[k] != defaults.get(k)]
+" "$work/config.json" "$work/defaults.yaml"
+fails_with "dump-config --json over its --config" "destroy the input" "$keyplace" dump-config \
+  --config "$work/defaults.yaml" --json "$work/defaults.yaml"
 check "dump-config --set" sh -c "'$keyplace' dump-config --set place.ransac.iterations=40 | grep -q '^    iterations: 40 '"
 check "map with the dumped defaults" "$keyplace" map "$log" --config "$work/defaults.yaml" \
   --out "$work/map-config.kpm"

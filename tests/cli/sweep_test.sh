@@ -35,7 +35,8 @@ for kind in place mapping; do
   if [ "$first" -eq 4 ] && [ "$first" -lt "$total" ]; then ok; else
     fail "$kind: --stop-after 4 left $first of $total rows"
   fi
-  "$keyplace" "${args[@]}" --threads 2 --out "$work/$kind-cut" >"$work/out2" 2>&1
+  "$keyplace" "${args[@]}" --threads 2 --out "$work/$kind-cut" --json "$work/$kind.json" \
+    >"$work/out2" 2>&1
   if grep -q "points, $first done before" "$work/out2"; then ok; else
     fail "$kind: resume did not skip the $first finished points"
     head -3 "$work/out2"
@@ -60,6 +61,17 @@ j = json.load(open(sys.argv[1]))
 keys = [tuple(r[p] for p in j["parameters"]) for r in j["rows"]]
 assert len(keys) == int(sys.argv[2]), (len(keys), sys.argv[2])
 assert keys == sorted(keys), "rows not sorted"
+EOF
+  # --json: the same rows as results.json, with what this run did (the resume: total - first).
+  if python3 - "$work/$kind-cut/results.json" "$work/$kind.json" "$total" "$first" \
+    "$work/$kind-cut" <<'EOF'; then ok; else fail "$kind: --json"; fi
+import json, sys
+results, j = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+total, first = int(sys.argv[3]), int(sys.argv[4])
+for key in ("sweep", "parameters", "columns", "rows"):
+    assert j[key] == results[key], key
+assert j["grid_points"] == total and j["computed_now"] == total - first, j
+assert j["out"] == sys.argv[5] and j["seconds_total"] > 0, j
 EOF
 done
 

@@ -1,5 +1,5 @@
-// A fix as the /initialpose message (issue 16): the pose, its quaternion and the covariance the
-// fix filter holds, in YAML that ROS tools parse and in JSON.
+// A fix as the /initialpose message (issue 16): the pose, its quaternion and the covariance
+// derived from the matches, in YAML that ROS tools parse and in JSON.
 
 #include <cmath>
 #include <fstream>
@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -18,11 +19,19 @@
 namespace keyplace {
 namespace {
 
-LocalizationResult Answer(const Pose2& T_world_odom) {
+// The covariance a match gives (PlaceMatch::estimated_pose_covariance), with off-diagonal terms.
+Eigen::Matrix3d MatchCovariance(double scale) {
+  Eigen::Matrix3d covariance;
+  covariance << 0.004, 0.001, 0.0002, 0.001, 0.002, -0.0001, 0.0002, -0.0001, 0.00005;
+  return scale * covariance;
+}
+
+LocalizationResult Answer(const Pose2& T_world_odom, double covariance_scale = 1.0) {
   LocalizationResult answer;
   answer.found = true;
   answer.confidence = 0.5;
   answer.T_world_odom = T_world_odom;
+  answer.match.estimated_pose_covariance = MatchCovariance(covariance_scale);
   return answer;
 }
 
@@ -39,7 +48,7 @@ FixFilter FixedFilter(const FixPolicy& policy) {
   return filter;
 }
 
-TEST(InitialPose, TheCovarianceIsTheFiltersAndGrowsWithUnconfirmedTravel) {
+TEST(InitialPose, TheFiltersVariancesGrowWithUnconfirmedTravel) {
   const FixPolicy policy;
   FixFilter filter = FixedFilter(policy);
   const RelocalizationUpdate at_fix = filter.Update(std::nullopt, Odometry(6));
@@ -58,6 +67,67 @@ TEST(InitialPose, TheCovarianceIsTheFiltersAndGrowsWithUnconfirmedTravel) {
   const RelocalizationUpdate confirmed = filter.Update(Answer(kTrue), Odometry(47));
   EXPECT_TRUE(confirmed.confirmed);
   EXPECT_LT(confirmed.position_variance_m2, at_fix.position_variance_m2);
+}
+
+TEST(InitialPose, TheCovarianceIsTheMatchesCarriedByOdometryAndFusedLikeTheFix) {
+  const FixPolicy policy;
+  FixFilter filter = FixedFilter(policy);
+  // The map's own error is added to whatever the matches say.
+  Eigen::Matrix3d map_error = Eigen::Matrix3d::Zero();
+  map_error(0, 0) = map_error(1, 1) = policy.map_sigma_m * policy.map_sigma_m;
+  map_error(2, 2) = std::pow(policy.map_sigma_deg * M_PI / 180.0, 2);
+  // At the fix: the covariance of the answer that made it, as it is (the robot has not moved).
+  const RelocalizationUpdate at_fix = filter.Update(std::nullopt, Odometry(6));
+  EXPECT_TRUE(at_fix.covariance.isApprox(MatchCovariance(1.0) + map_error, 1e-14))
+      << at_fix.covariance;
+  // 10 m later: the heading error moves the robot by the lever arm (the displacement in the map
+  // turned by 90 degrees), and the drift allowance is added.
+  const RelocalizationUpdate later = filter.Update(std::nullopt, Odometry(46));
+  const Eigen::Vector2d moved =
+      (kTrue * Odometry(46)).translation() - (kTrue * Odometry(6)).translation();
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Identity();
+  jacobian(0, 2) = -moved.y();
+  jacobian(1, 2) = moved.x();
+  const double drift_m = policy.agree_per_m * 10.0;
+  const double heading_drift_rad =
+      drift_m / (0.5 * policy.agree_m) * (0.5 * policy.agree_deg * M_PI / 180.0);
+  Eigen::Matrix3d expected = jacobian * MatchCovariance(1.0) * jacobian.transpose();
+  expected(0, 0) += drift_m * drift_m;
+  expected(1, 1) += drift_m * drift_m;
+  expected(2, 2) += heading_drift_rad * heading_drift_rad;
+  expected += map_error;
+  EXPECT_TRUE(later.covariance.isApprox(expected, 1e-12)) << later.covariance << "\n" << expected;
+  // A confirming answer with twice the covariance: the new fix is (1 - w) fix + w answer, with the
+  // filter's weight w, so its covariance is (1 - w)^2 C_fix + w^2 C_answer.
+  const double travelled = 10.25;
+  const double fix_variance =
+      0.25 * policy.agree_m * policy.agree_m + std::pow(policy.agree_per_m * travelled, 2);
+  const double weight = fix_variance / (fix_variance + 0.25 * policy.agree_m * policy.agree_m);
+  const Eigen::Vector2d moved47 =
+      (kTrue * Odometry(47)).translation() - (kTrue * Odometry(6)).translation();
+  jacobian(0, 2) = -moved47.y();
+  jacobian(1, 2) = moved47.x();
+  const double drift47_m = policy.agree_per_m * travelled;
+  const double heading_drift47_rad =
+      drift47_m / (0.5 * policy.agree_m) * (0.5 * policy.agree_deg * M_PI / 180.0);
+  Eigen::Matrix3d fix_now = jacobian * MatchCovariance(1.0) * jacobian.transpose();
+  fix_now(0, 0) += drift47_m * drift47_m;
+  fix_now(1, 1) += drift47_m * drift47_m;
+  fix_now(2, 2) += heading_drift47_rad * heading_drift47_rad;
+  const Eigen::Matrix3d fused =
+      (1.0 - weight) * (1.0 - weight) * fix_now + weight * weight * MatchCovariance(2.0);
+  const RelocalizationUpdate confirmed = filter.Update(Answer(kTrue, 2.0), Odometry(47));
+  ASSERT_TRUE(confirmed.confirmed);
+  // (the map's error is shared by all answers: added once, not fused away)
+  EXPECT_TRUE(confirmed.covariance.isApprox(fused + map_error, 1e-12))
+      << confirmed.covariance << "\n"
+      << fused + map_error;
+  // A worse match makes a fix with a larger covariance.
+  FixFilter worse(policy);
+  worse.Update(Answer(kTrue, 5.0), Odometry(0));
+  const RelocalizationUpdate worse_fix = worse.Update(Answer(kTrue, 5.0), Odometry(6));
+  ASSERT_EQ(worse_fix.status, FixStatus::kFixed);
+  EXPECT_GT(worse_fix.covariance.trace(), at_fix.covariance.trace());
 }
 
 TEST(InitialPose, YamlAndJsonCarryThePoseQuaternionAndCovariance) {
@@ -79,14 +149,21 @@ TEST(InitialPose, YamlAndJsonCarryThePoseQuaternionAndCovariance) {
     EXPECT_NEAR(std::remainder(yaw - expected.theta, 2.0 * M_PI), 0.0, 1e-12);
     const auto covariance = message["pose"]["covariance"].as<std::vector<double>>();
     ASSERT_EQ(covariance.size(), 36U);
-    EXPECT_DOUBLE_EQ(covariance[0], update.position_variance_m2);    // x x
-    EXPECT_DOUBLE_EQ(covariance[7], update.position_variance_m2);    // y y
-    EXPECT_DOUBLE_EQ(covariance[35], update.heading_variance_rad2);  // yaw yaw
-    double others = 0.0;
-    for (std::size_t i = 0; i < 36; ++i) {
-      if (i != 0 && i != 7 && i != 35) others += std::abs(covariance[i]);
+    // Row-major over x, y, z, roll, pitch, yaw: the (x, y, yaw) block in rows/columns 0, 1, 5.
+    const std::size_t axis[3] = {0, 1, 5};
+    double in_block = 0.0;
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_DOUBLE_EQ(
+            covariance[6 * axis[r] + axis[c]],
+            update.covariance(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)));
+        in_block += std::abs(covariance[6 * axis[r] + axis[c]]);
+      }
     }
-    EXPECT_EQ(others, 0.0);
+    EXPECT_NE(update.covariance(0, 1), 0.0);  // the off-diagonal terms are there
+    double all = 0.0;
+    for (const double value : covariance) all += std::abs(value);
+    EXPECT_EQ(all, in_block);  // z, roll and pitch: 0
   }
   std::ifstream json(dir + "/fix.json");
   const std::string text{std::istreambuf_iterator<char>(json), std::istreambuf_iterator<char>()};

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +114,122 @@ TEST(Ransac, ScoreIsMeanTruncatedSquaredDistance) {
   EXPECT_NEAR(score, (0.0025 + 0.01) / 2.0, 1e-12);
   ASSERT_EQ(inliers.size(), 1u);
   EXPECT_EQ(inliers[0], std::make_pair(0, 0));
+}
+
+// The match covariance (RigidFitCovariance): n points with centroid at the current frame's origin
+// and the true transform, each reference point displaced by a known residual.
+struct FitScene {
+  std::vector<Eigen::Vector2d> reference;
+  std::vector<Eigen::Vector2d> current;
+  std::vector<std::pair<int, int>> pairs;
+};
+
+FitScene Ring(int n, double radius_m, double residual_m, const Pose2& T_ref_cur) {
+  FitScene scene;
+  for (int i = 0; i < n; ++i) {
+    const double angle = 2.0 * M_PI * i / n;
+    const Eigen::Vector2d c(radius_m * std::cos(angle), radius_m * std::sin(angle));
+    // Residuals alternate in sign along x and y: they sum to zero, so T_ref_cur stays the fit.
+    const Eigen::Vector2d e(i % 2 == 0 ? residual_m : -residual_m,
+                            (i / 2) % 2 == 0 ? residual_m : -residual_m);
+    scene.current.push_back(c);
+    scene.reference.push_back(T_ref_cur * c + e);
+    scene.pairs.emplace_back(i, i);
+  }
+  return scene;
+}
+
+TEST(RigidFitCovariance, HandComputedForPointsAroundTheOrigin) {
+  // At theta = 0 with the centroid at the origin, sum J^T J = diag(n, n, sum |c|^2); every
+  // residual has |e|^2 = 2 e^2, so sigma^2 = n 2 e^2 / (2 n - 3).
+  const int n = 8;
+  const double radius = 2.0;
+  const double e = 0.05;
+  const FitScene scene = Ring(n, radius, e, Pose2(1.0, -3.0, 0.0));
+  const Eigen::Matrix3d covariance =
+      RigidFitCovariance(scene.reference, scene.current, scene.pairs, Pose2(1.0, -3.0, 0.0), 0.0);
+  const double sigma2 = n * 2.0 * e * e / (2.0 * n - 3.0);
+  EXPECT_NEAR(covariance(0, 0), sigma2 / n, 1e-15);
+  EXPECT_NEAR(covariance(1, 1), sigma2 / n, 1e-15);
+  EXPECT_NEAR(covariance(2, 2), sigma2 / (n * radius * radius), 1e-15);
+  EXPECT_NEAR(covariance(0, 1), 0.0, 1e-15);
+  EXPECT_NEAR(covariance(0, 2), 0.0, 1e-15);
+}
+
+TEST(RigidFitCovariance, SpreadOutInliersGiveASmallerCovarianceThanClusteredOnes) {
+  const Pose2 T(0.5, 0.2, 0.7);
+  const FitScene spread = Ring(12, 5.0, 0.04, T);
+  const FitScene clustered = Ring(12, 0.3, 0.04, T);
+  const Eigen::Matrix3d a =
+      RigidFitCovariance(spread.reference, spread.current, spread.pairs, T, 0);
+  const Eigen::Matrix3d b =
+      RigidFitCovariance(clustered.reference, clustered.current, clustered.pairs, T, 0);
+  // The heading is pinned by points far apart: (5 / 0.3)^2 times better.
+  EXPECT_NEAR(b(2, 2) / a(2, 2), (5.0 / 0.3) * (5.0 / 0.3), 1e-6);
+  EXPECT_LT(a.trace(), b.trace());
+  // Positions, expressed away from the points, inherit the heading error by the lever arm.
+  const Pose2 far(20.0, 0.0, 0.0);
+  EXPECT_LT(ComposedCovariance(Pose2(), T, far, a).trace(),
+            ComposedCovariance(Pose2(), T, far, b).trace());
+}
+
+TEST(RigidFitCovariance, LargerResidualsGiveALargerCovarianceAboveTheFloor) {
+  const Pose2 T(-1.0, 2.0, -2.5);
+  const FitScene small = Ring(10, 3.0, 0.04, T);
+  const FitScene large = Ring(10, 3.0, 0.08, T);
+  const Eigen::Matrix3d a =
+      RigidFitCovariance(small.reference, small.current, small.pairs, T, 0.03);
+  const Eigen::Matrix3d b =
+      RigidFitCovariance(large.reference, large.current, large.pairs, T, 0.03);
+  // Twice the residuals, four times the covariance (both above the floor).
+  EXPECT_TRUE(b.isApprox(4.0 * a, 1e-12)) << a << "\n" << b;
+  // Exact points: the floor, sigma = 0.03 m, and not zero.
+  const FitScene exact = Ring(10, 3.0, 0.0, T);
+  const Eigen::Matrix3d floor =
+      RigidFitCovariance(exact.reference, exact.current, exact.pairs, T, 0.03);
+  const Eigen::Matrix3d unit =
+      RigidFitCovariance(exact.reference, exact.current, exact.pairs, T, 1.0);
+  EXPECT_TRUE(floor.isApprox(0.03 * 0.03 * unit, 1e-12));
+  EXPECT_GT(floor(0, 0), 0.0);
+  // 0.01 m residuals fall below the floor: the same as exact points.
+  const FitScene tiny = Ring(10, 3.0, 0.01, T);
+  EXPECT_TRUE(
+      RigidFitCovariance(tiny.reference, tiny.current, tiny.pairs, T, 0.03).isApprox(floor, 1e-12));
+}
+
+TEST(RigidFitCovariance, UndeterminedFitsAreInfiniteAndBadIndicesRefused) {
+  const std::vector<Eigen::Vector2d> points = {{1, 1}, {1, 1}, {1, 1}};
+  const Eigen::Matrix3d one = RigidFitCovariance(points, points, {{0, 0}}, Pose2(), 0.03);
+  EXPECT_TRUE(std::isinf(one(0, 0)) && std::isinf(one(2, 2)));
+  EXPECT_EQ(one(0, 1), 0.0);
+  const Eigen::Matrix3d same_spot =
+      RigidFitCovariance(points, points, {{0, 0}, {1, 1}, {2, 2}}, Pose2(), 0.03);
+  EXPECT_TRUE(std::isinf(same_spot(2, 2)));
+  EXPECT_THROW(RigidFitCovariance(points, points, {{0, 0}, {3, 1}}, Pose2(), 0.03),
+               std::invalid_argument);
+}
+
+TEST(RigidFitCovariance, ComposedCovarianceMatchesNumericalDerivatives) {
+  const Pose2 T_a_b(3.0, -1.0, 0.4);
+  const Pose2 T_b_c(0.5, 2.0, -1.2);
+  const Pose2 T_c_d(4.0, 1.5, 0.3);
+  Eigen::Matrix3d covariance;
+  covariance << 0.04, 0.01, 0.002, 0.01, 0.09, -0.003, 0.002, -0.003, 0.0004;
+  // Numerical Jacobian of T_a_b * T_b_c(x, y, theta) * T_c_d over T_b_c's parameters.
+  const Pose2 base = T_a_b * T_b_c * T_c_d;
+  Eigen::Matrix3d jacobian;
+  const double h = 1e-7;
+  for (int k = 0; k < 3; ++k) {
+    Pose2 moved_b_c = T_b_c;
+    (k == 0 ? moved_b_c.x : k == 1 ? moved_b_c.y : moved_b_c.theta) += h;
+    const Pose2 moved = T_a_b * moved_b_c * T_c_d;
+    jacobian.col(k) << (moved.x - base.x) / h, (moved.y - base.y) / h,
+        WrapAngle(moved.theta - base.theta) / h;
+  }
+  const Eigen::Matrix3d expected = jacobian * covariance * jacobian.transpose();
+  EXPECT_TRUE(ComposedCovariance(T_a_b, T_b_c, T_c_d, covariance).isApprox(expected, 1e-5))
+      << ComposedCovariance(T_a_b, T_b_c, T_c_d, covariance) << "\n"
+      << expected;
 }
 
 }  // namespace

@@ -119,17 +119,18 @@ class GridTest(unittest.TestCase):
 
 class InitialPoseTest(unittest.TestCase):
     def test_message_fields(self):
-        pose = keyplace.InitialPose([1.5, -2.0, 0.5], position_variance_m2=0.04,
-                                    heading_variance_rad2=0.01)
+        xy_yaw = np.array([[0.04, 0.01, 0.002], [0.01, 0.03, -0.001], [0.002, -0.001, 0.01]])
+        pose = keyplace.InitialPose([1.5, -2.0, 0.5], covariance=xy_yaw)
         message = json.loads(pose.to_json())
         self.assertEqual(message["header"]["frame_id"], "map")
         position = message["pose"]["pose"]["position"]
         self.assertEqual((position["x"], position["y"], position["z"]), (1.5, -2.0, 0.0))
         q = message["pose"]["pose"]["orientation"]
         self.assertAlmostEqual(2 * math.atan2(q["z"], q["w"]), 0.5, places=12)
+        # The (x, y, yaw) block in rows and columns 0, 1 and 5 of x, y, z, roll, pitch, yaw.
         expected = np.zeros((6, 6))
-        expected[0, 0] = expected[1, 1] = 0.04
-        expected[5, 5] = 0.01
+        expected[np.ix_([0, 1, 5], [0, 1, 5])] = xy_yaw
+        np.testing.assert_array_equal(pose.pose_covariance, xy_yaw)
         np.testing.assert_array_equal(pose.covariance, expected)
         np.testing.assert_array_equal(np.reshape(message["pose"]["covariance"], (6, 6)), expected)
         self.assertIn("frame_id: map", pose.to_yaml())
@@ -143,6 +144,10 @@ class InitialPoseTest(unittest.TestCase):
             keyplace.InitialPose([0, 0, 0], frame_id="my map").to_yaml()
         with self.assertRaisesRegex(ValueError, "pose"):
             keyplace.InitialPose([0, 0])
+        with self.assertRaisesRegex(ValueError, "covariance"):
+            keyplace.InitialPose([0, 0, 0], covariance=np.zeros((2, 2)))
+        np.testing.assert_array_equal(keyplace.InitialPose([0, 0, 0]).pose_covariance,
+                                      np.zeros((3, 3)))
 
     def test_relocalizer_fix_as_initial_pose(self):
         with tempfile.TemporaryDirectory() as folder:
@@ -162,9 +167,16 @@ class InitialPoseTest(unittest.TestCase):
         pose = fixed.initial_pose(frame_id="world")
         self.assertEqual(pose.frame_id, "world")
         np.testing.assert_array_equal(pose.pose, fixed.pose)
-        self.assertEqual(pose.position_variance_m2, fixed.position_variance_m2)
-        self.assertEqual(pose.heading_variance_rad2, fixed.heading_variance_rad2)
-        self.assertGreater(pose.position_variance_m2, 0)
+        # The covariance derived from the matches: symmetric, positive definite, decimetres at
+        # most, and the fix's own answer's (PlaceMatch) with the map's error added.
+        np.testing.assert_array_equal(pose.pose_covariance, fixed.covariance)
+        np.testing.assert_allclose(fixed.covariance, fixed.covariance.T, atol=1e-15)
+        self.assertTrue((np.linalg.eigvalsh(fixed.covariance) > 0).all())
+        self.assertLess(fixed.covariance[0, 0], 0.5 ** 2)
+        match_covariance = fixed.answer.match.estimated_pose_covariance
+        self.assertGreater(match_covariance[0, 0], 0)
+        map_error = np.diag([0.03 ** 2, 0.03 ** 2, math.radians(0.3) ** 2])  # localization.fix
+        np.testing.assert_allclose(fixed.covariance, match_covariance + map_error, rtol=1e-12)
 
 
 if __name__ == "__main__":

@@ -71,7 +71,23 @@ expect 'Quick mode' "$page" "quick-mode warning"
 if grep -q '<h2>Warnings' "$page"; then fail "the page has warnings"; else ok; fi
 
 # A rerun reuses everything.
-if "${run[@]}" --out "$out" >"$work/second.txt" 2>&1; then ok; else fail "second run"; fi
+if "${run[@]}" --out "$out" --json "$work/second.json" >"$work/second.txt" 2>&1; then ok; else
+  fail "second run"
+fi
+# --json: where the page is and what became of each step (here: all reused or skipped).
+if /usr/bin/python3 - "$work/second.json" "$out" "$ran" "$skipped" <<'EOF'; then ok; else fail "report --json"; fi
+import json, os, sys
+j = json.load(open(sys.argv[1]))
+out, ran, skipped = sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+assert j["index"] == os.path.join(out, "index.html") and j["page_bytes"] == os.path.getsize(j["index"]), j
+assert j["work"] == os.path.join(out, "work") and j["datasets"] == "fr079" and j["quick"], j
+assert (j["steps_ran"], j["steps_done_before"], j["steps_skipped"], j["steps_failed"]) == (0, ran, skipped, 0), j
+assert j["steps_total"] == len(j["steps"]) == ran + skipped, j
+states = {s["state"] for s in j["steps"]}
+assert states <= {"done", "skipped"}, states
+assert all(s["command"].startswith("keyplace ") for s in j["steps"]), j["steps"][0]
+assert all(s["message"] for s in j["steps"] if s["state"] == "skipped"), j["steps"]
+EOF
 expect "Steps: 0 ran, $ran reused, $skipped skipped, 0 failed" "$page" "rerun reuses the $ran artefacts"
 if grep -q '^    keyplace ' "$work/second.txt"; then fail "the rerun ran a command"; else ok; fi
 

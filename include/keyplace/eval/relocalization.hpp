@@ -53,11 +53,9 @@ struct FixEvent {
   Pose2 T_world_robot;
   Pose2 truth;
   double confidence = 0.0;
-  // As reported at `scan`: the robot's pose and the fix's variances (RelocalizationUpdate), what
-  // a robot would publish on /initialpose.
-  Pose2 T_world_robot_at_fix;
-  double position_variance_m2 = 0.0;
-  double heading_variance_rad2 = 0.0;
+  // As reported at `scan`: InitialPoseOf(the update), what a robot would publish on
+  // /initialpose (frame "map"; pose T_world_robot at `scan`, covariance from the matches).
+  InitialPose initial_pose;
   bool correct = false;
   bool first = false;  // the start's first fix
 };
@@ -135,9 +133,5 @@ struct FirstFix {
 };
 /// Nothing when no start got a fix.
 std::optional<FirstFix> FirstFixOf(const std::vector<StartRecord>& records);
-
-/// A fix as the /initialpose message: the robot's pose and the variances as reported at the fix
-/// (FixEvent::T_world_robot_at_fix, position_variance_m2, heading_variance_rad2).
-InitialPose InitialPoseOf(const FixEvent& fix, const std::string& frame_id = "map");
 
 }  // namespace keyplace

@@ -6,6 +6,8 @@
 #include <array>
 #include <string>
 
+#include <Eigen/Core>
+
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/localization/relocalizer.hpp"
 
@@ -14,16 +16,18 @@ namespace keyplace {
 struct InitialPose {
   std::string frame_id = "map";  // the map's frame: the grid keyplace exports is in it
   Pose2 T_map_robot;
-  double position_variance_m2 = 0.0;  // of x and of y
-  double heading_variance_rad2 = 0.0;
+  // Over (x, y, yaw) of T_map_robot (m^2, m rad, rad^2): RelocalizationUpdate::covariance,
+  // derived from the matches (docs/NAVIGATION.md).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
-/// The fix of an update whose status is kFixed (std::invalid_argument otherwise), with the
-/// filter's variances.
+/// The fix of an update whose status is kFixed (std::invalid_argument otherwise): its pose and
+/// covariance. The one way to make the message from the localizer (the evaluation's FixEvent
+/// keeps what this gives at the fix).
 InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string& frame_id = "map");
 
-/// The message's 6x6 covariance, row-major over x, y, z, roll, pitch, yaw: the position variance
-/// on the x and y diagonal terms, the heading variance on the yaw one, 0 elsewhere.
+/// The message's 6x6 covariance, row-major over x, y, z, roll, pitch, yaw: the (x, y, yaw) terms
+/// of InitialPose::covariance in their places (indices 0, 1, 5 of each row), 0 elsewhere.
 std::array<double, 36> InitialPoseCovariance(const InitialPose& pose);
 
 /// The message as YAML (header without stamp: a zero stamp means "now" to AMCL, and leaving it

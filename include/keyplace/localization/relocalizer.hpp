@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/features/keypoint.hpp"
@@ -57,6 +59,12 @@ struct RelocalizationUpdate {
   // and heading, as the filter weighs answers against odometry drift (docs/LOCALIZATION.md).
   double position_variance_m2 = 0.0;
   double heading_variance_rad2 = 0.0;
+  // Valid when status is kFixed: the covariance of T_world_robot over its (x, y, theta), derived
+  // from the matches (PlaceMatch::estimated_pose_covariance of the answer that made the fix,
+  // fused as the filter fuses the confirming answers, carried to the robot's pose now through
+  // odometry) plus the same drift allowance as the variances above, plus the map's own error
+  // (FixPolicy::map_sigma_m, map_sigma_deg). What /initialpose gets.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   // The localizer's answer when a query submap completed with this scan.
   std::optional<LocalizationResult> answer;
   // The answer was accepted and agreed with the fix (confirmation) or contradicted it.
@@ -84,6 +92,9 @@ class FixFilter {
     Pose2 T_world_odom;
     double confidence = 0.0;
     double odometry_m = 0.0;  // odometry distance when it was given
+    // Covariance of the robot's pose in the map at T_odom_robot, from the match.
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    Pose2 T_odom_robot;
   };
 
   void Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
@@ -97,6 +108,8 @@ class FixFilter {
   void DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest,
                   RelocalizationUpdate& update);
   void DeclareLost(RelocalizationUpdate& update);
+  // fix_covariance_ carried to the robot's odometry pose T_odom_robot, plus the drift allowance.
+  Eigen::Matrix3d FixCovarianceAt(const Pose2& T_odom_robot) const;
 
   FixPolicy policy_;
   FixStatus status_ = FixStatus::kSearching;
@@ -108,6 +121,10 @@ class FixFilter {
   double fix_confidence_ = 0.0;
   double fix_variance_m2_ = 0.0;  // of the fix's position at its last confirmation
   double confirmed_at_m_ = 0.0;   // odometry distance of the last confirmation
+  // Covariance of the fix (robot pose in the map) at odometry pose fix_covariance_at_, at the last
+  // confirmation, derived from the matches.
+  Eigen::Matrix3d fix_covariance_ = Eigen::Matrix3d::Zero();
+  Pose2 fix_covariance_at_;
 };
 
 /// A copy shares the map's place recognizer (read-only; safe from several threads) and has its own

@@ -101,7 +101,10 @@ struct CandidateResult {
   bool verified = false;            // passed all checks
   Pose2 T_ref_cur;
   Pose2 estimated_pose;  // Eq. (9)
-  double score = 0.0;    // selection score (PlaceRecognitionConfig::score), verified only
+  // Covariance of estimated_pose over its (x, y, theta) (world frame): RigidFitCovariance of the
+  // RANSAC inliers, carried through T_world_place and the query's pose (ComposedCovariance).
+  Eigen::Matrix3d estimated_pose_covariance = Eigen::Matrix3d::Zero();
+  double score = 0.0;  // selection score (PlaceRecognitionConfig::score), verified only
 };
 
 struct PlaceMatch {
@@ -116,6 +119,8 @@ struct PlaceMatch {
   int place_id = -1;
   Pose2 T_ref_cur;       // P_c[0] in the frame of P_r[0]
   Pose2 estimated_pose;  // p^ = P_r[0] * T_ref_cur * p_c (Eq. 9), world frame
+  // Its covariance over (x, y, theta), derived from the match (CandidateResult).
+  Eigen::Matrix3d estimated_pose_covariance = Eigen::Matrix3d::Zero();
   int pairs = 0;
   int consensus = 0;
   double gamma = 0.0;
