@@ -184,11 +184,13 @@ void BindGrid(py::module_& module) {
       "ValueError naming the file and field that is wrong, RuntimeError for a missing file.");
 }
 
-InitialPose MakeInitialPose(const py::object& pose, const py::object& covariance,
+InitialPose MakeInitialPose(const py::object& pose, const py::object& pose_covariance,
                             const std::string& frame_id) {
   InitialPose initial;
   initial.T_map_robot = ToPose(pose, "pose");
-  if (!covariance.is_none()) initial.covariance = ToCovariance(covariance, "covariance");
+  if (!pose_covariance.is_none()) {
+    initial.covariance = ToCovariance(pose_covariance, "pose_covariance");
+  }
   initial.frame_id = frame_id;
   return initial;
 }
@@ -199,10 +201,12 @@ void BindInitialPose(py::module_& module) {
       "A fix as a geometry_msgs/PoseWithCovarianceStamped for /initialpose (AMCL, nav2): the "
       "robot's pose in the map frame with a covariance derived from the matches "
       "(docs/NAVIGATION.md).")
-      .def(py::init(&MakeInitialPose), py::arg("pose"), py::arg("covariance") = py::none(),
+      // The keyword is the 3 x 3 property's name: `.covariance` is the message's 6 x 6 array.
+      .def(py::init(&MakeInitialPose), py::arg("pose"), py::arg("pose_covariance") = py::none(),
            py::arg("frame_id") = "map",
-           "InitialPose(pose, covariance=None, frame_id='map'): pose is T_map_robot [x_m, y_m, "
-           "theta_rad], covariance a 3 x 3 array over (x, y, theta) (None: zeros).")
+           "InitialPose(pose, pose_covariance=None, frame_id='map'): pose is T_map_robot [x_m, "
+           "y_m, theta_rad], pose_covariance a 3 x 3 array over (x, y, theta) (None: zeros), as "
+           "the pose_covariance property gives it.")
       .def_readonly("frame_id", &InitialPose::frame_id)
       .def_property_readonly(
           "pose", [](const InitialPose& p) { return PoseArray(p.T_map_robot); },

@@ -50,6 +50,11 @@ void PrintEvaluation(const MergeEvaluation& evaluation) {
       "with both sessions' drift)\n",
       origins.error.translation_m, origins.error.rotation_deg, origins.scan_b, origins.scan_a);
   const ErrorStats& stats = evaluation.at_recognitions_stats;
+  if (stats.count == 0) {  // an empty mean is not a perfect merge
+    fmt::print("error where they meet none: no agreeing recognition has truth poses ({} without)\n",
+               evaluation.recognitions_without_truth);
+    return;
+  }
   fmt::print(
       "error where they meet {:.3f} m, {:.3f} deg mean, {:.3f} m, {:.3f} deg max over {} agreeing "
       "recognitions with truth poses ({} without)\n",
@@ -61,6 +66,17 @@ void PrintEvaluation(const MergeEvaluation& evaluation) {
       "transform)\n",
       alone.translation_mean_m, alone.rotation_mean_deg, alone.translation_max_m,
       alone.rotation_max_deg);
+}
+
+// Mean and max of an error list, null when the list is empty.
+nlohmann::json StatsJson(const ErrorStats& stats) {
+  const auto value = [&](double x) {
+    return stats.count == 0 ? nlohmann::json() : nlohmann::json(x);
+  };
+  return {{"translation_mean_m", value(stats.translation_mean_m)},
+          {"translation_max_m", value(stats.translation_max_m)},
+          {"rotation_mean_deg", value(stats.rotation_mean_deg)},
+          {"rotation_max_deg", value(stats.rotation_max_deg)}};
 }
 
 nlohmann::json PlacementJson(const MergePlacementError& placement) {
@@ -86,17 +102,10 @@ nlohmann::json EvaluationJson(const MergeCommandOptions& options,
   json["index"] = options.index_path;
   json["at_origins"] = PlacementJson(evaluation.at_origins);
   const ErrorStats& stats = evaluation.at_recognitions_stats;
-  json["at_recognitions"] = {{"count", stats.count},
-                             {"without_truth", evaluation.recognitions_without_truth},
-                             {"translation_mean_m", stats.translation_mean_m},
-                             {"translation_max_m", stats.translation_max_m},
-                             {"rotation_mean_deg", stats.rotation_mean_deg},
-                             {"rotation_max_deg", stats.rotation_max_deg}};
-  const ErrorStats& alone = evaluation.recognitions_alone_stats;
-  json["recognitions_alone"] = {{"translation_mean_m", alone.translation_mean_m},
-                                {"translation_max_m", alone.translation_max_m},
-                                {"rotation_mean_deg", alone.rotation_mean_deg},
-                                {"rotation_max_deg", alone.rotation_max_deg}};
+  json["at_recognitions"] = StatsJson(stats);
+  json["at_recognitions"]["count"] = stats.count;
+  json["at_recognitions"]["without_truth"] = evaluation.recognitions_without_truth;
+  json["recognitions_alone"] = StatsJson(evaluation.recognitions_alone_stats);
   nlohmann::json items = nlohmann::json::array();
   for (const MergePlacementError& placement : evaluation.at_recognitions) {
     items.push_back(PlacementJson(placement));

@@ -1,10 +1,13 @@
 #include "keyplace/place/ransac.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
+
+#include <Eigen/Dense>
 
 #include "place/nearest_reference.hpp"
 

@@ -120,7 +120,7 @@ class GridTest(unittest.TestCase):
 class InitialPoseTest(unittest.TestCase):
     def test_message_fields(self):
         xy_yaw = np.array([[0.04, 0.01, 0.002], [0.01, 0.03, -0.001], [0.002, -0.001, 0.01]])
-        pose = keyplace.InitialPose([1.5, -2.0, 0.5], covariance=xy_yaw)
+        pose = keyplace.InitialPose([1.5, -2.0, 0.5], pose_covariance=xy_yaw)
         message = json.loads(pose.to_json())
         self.assertEqual(message["header"]["frame_id"], "map")
         position = message["pose"]["pose"]["position"]
@@ -145,7 +145,7 @@ class InitialPoseTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "pose"):
             keyplace.InitialPose([0, 0])
         with self.assertRaisesRegex(ValueError, "covariance"):
-            keyplace.InitialPose([0, 0, 0], covariance=np.zeros((2, 2)))
+            keyplace.InitialPose([0, 0, 0], pose_covariance=np.zeros((2, 2)))
         np.testing.assert_array_equal(keyplace.InitialPose([0, 0, 0]).pose_covariance,
                                       np.zeros((3, 3)))
 

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Dense>
 
 #include "keyplace/common/pose2.hpp"
 
