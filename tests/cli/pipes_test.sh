@@ -108,6 +108,30 @@ all_figures="scans lines beams_total beams_per_scan_max field_of_view_deg line_c
   fails_with "a map given as the log of map" "an SQLite database (a keyplace map file or" \
     timeout $limit "$keyplace" map "$work/file.kpm" --out "$work/other.kpm"
 
+  # The relation and index files are read once, front to back: through pipes they give the
+  # file's figures (the raw log, its relations and its index to the corrected log are shared data).
+  shared="$source_dir/../shared/data"
+  if [ -f "$shared/fr079-raw.log.gz" ]; then
+    odometry=("$keyplace" odometry "$shared/fr079-raw.log.gz" --scans 0:300
+      --corrected "$shared/fr079-corrected.log.gz")
+    check "odometry with relations and index files" timeout $limit "${odometry[@]}" \
+      --relations "$shared/fr079.relations" \
+      --raw-to-corrected "$shared/fr079-raw-to-corrected.tsv" --json "$work/odo_file.json"
+    check "odometry with relations and index through pipes" timeout $limit "${odometry[@]}" \
+      --relations <(cat "$shared/fr079.relations") \
+      --raw-to-corrected <(cat "$shared/fr079-raw-to-corrected.tsv") --json "$work/odo_pipe.json"
+    check "  the same relation errors and drift" /usr/bin/python3 - "$work/odo_file.json" \
+      "$work/odo_pipe.json" <<'EOF'
+import json, sys
+a, b = (json.load(open(path)) for path in sys.argv[1:3])
+assert a["icp"]["matched"] > 50 and a["icp"] == b["icp"], (a["icp"], b["icp"])
+drift = [{k: v for k, v in j["drift"].items() if k != "index_file"} for j in (a, b)]
+assert drift[0] == drift[1] and drift[0]["icp"]["consecutive"]["count"] > 50, drift
+EOF
+  else
+    echo "skipped the relation and index pipes: $shared/fr079-raw.log.gz not found"
+  fi
+
   # Bags need seeking too: refused through a pipe with the reason, not read as a text log.
   ros2="$source_dir/tests/data/ros2"
   fails_with "an MCAP bag through a pipe" "a ROS 2 MCAP file through a pipe or device" \
