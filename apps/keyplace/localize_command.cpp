@@ -86,7 +86,8 @@ GlobalMap WithDistractors(const GlobalMap& map, const std::vector<std::string>& 
 void RunLocalize(const LocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::string> input_paths = {options.query.log_path, options.query.truth_path,
-                                          options.query.index_path, options.map_path};
+                                          options.query.index_path, options.map_path,
+                                          options.config.file};
   input_paths.insert(input_paths.end(), options.distractor_paths.begin(),
                      options.distractor_paths.end());
   CheckOutputs({{"--json", options.json_path},

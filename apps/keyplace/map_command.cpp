@@ -145,7 +145,7 @@ void RunMap(const MapOptions& options) {
                                  {"--json", options.json_path},
                                  {"--png", options.png_path},
                                  {"--svg", options.svg_path}});
-  CheckOutputs(outputs, {options.input});
+  CheckOutputs(outputs, {options.input, options.config.file});
   const Config config = ResolveConfig(options.config, [&](Config& c) {
     if (options.overlap_only) {
       c.mapping.use_distribution = false;

@@ -140,9 +140,9 @@ nlohmann::json MergeJson(const MergeCommandOptions& options, const MergeResult& 
 
 void RunMerge(const MergeCommandOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs(
-      {{"--out", options.out_path}, {"--json", options.json_path}},
-      {options.map_a, options.map_b, options.log_path, options.truth_path, options.index_path});
+  CheckOutputs({{"--out", options.out_path}, {"--json", options.json_path}},
+               {options.map_a, options.map_b, options.log_path, options.truth_path,
+                options.index_path, options.config.file});
   if (options.log_path.empty() && !(options.truth_path.empty() && options.index_path.empty())) {
     throw std::invalid_argument("--truth and --index need --log (the log the maps were made from)");
   }

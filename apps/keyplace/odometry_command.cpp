@@ -42,7 +42,8 @@ void RunOdometry(const OdometryOptions& options) {
   CheckOutputs({{"--out", options.out_path},
                 {"--relation-errors", options.relation_errors_path},
                 {"--json", options.json_path}},
-               {options.input, options.relations_path, options.corrected_path, options.index_path});
+               {options.input, options.relations_path, options.corrected_path, options.index_path,
+                options.config.file});
   std::vector<std::string> aliases;
   if (!options.local_dt.empty()) {
     aliases.push_back("evaluation.local_relation_max_dt_s=" + options.local_dt);

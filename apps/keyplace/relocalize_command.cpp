@@ -58,7 +58,7 @@ void RunRelocalize(const RelocalizeOptions& options) {
                 {"--figure", options.figure_path},
                 {"--initialpose", options.initial_pose_path}},
                {options.query.log_path, options.query.truth_path, options.query.index_path,
-                options.map_path});
+                options.map_path, options.config.file});
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);

@@ -69,8 +69,8 @@ void RunSlam(const SlamOptions& options) {
                                  {"--trajectory", options.trajectory_path},
                                  {"--json", options.json_path},
                                  {"--loops", options.loops_path}});
-  CheckOutputs(outputs,
-               {options.input, options.truth_path, options.index_path, options.relations_path});
+  CheckOutputs(outputs, {options.input, options.truth_path, options.index_path,
+                         options.relations_path, options.config.file});
   const Config config = ResolveConfig(options.config);
   const ProcessingOrder order = ParseProcessingOrder(options.order);
   const LogInputs inputs = PrepareInputs(options.input, config);

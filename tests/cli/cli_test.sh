@@ -159,6 +159,14 @@ check "localize: --n-pos capped with a note" grep -qF "keyplace: note: --n-pos 5
   "$work/capped.err"
 check "localize: capped below the scans" test "$(json_value "$work/capped.json" n_pos)" -lt 40
 fails_with "missing file" "does not exist" "$keyplace" info "$work/missing.log"
+# An output must not be the configuration file it reads, under any command.
+"$keyplace" dump-config >"$work/own.yaml"
+cp "$work/own.yaml" "$work/own-before.yaml"
+fails_with "map --json onto its --config" "would destroy the input" "$keyplace" map "$log" \
+  --config "$work/own.yaml" --json "$work/own.yaml"
+fails_with "slam --json onto its --config" "would destroy the input" "$keyplace" slam "$log" \
+  --config "$work/own.yaml" --json "$work/own.yaml"
+check "the configuration file is unchanged" cmp "$work/own.yaml" "$work/own-before.yaml"
 fails_with "bad pose source" "--poses" "$keyplace" map "$log" --poses gps
 fails_with "bad --set key" "unknown configuration key 'mapping.no_such'" "$keyplace" map "$log" \
   --set mapping.no_such=1
