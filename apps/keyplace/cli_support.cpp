@@ -70,6 +70,28 @@ void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& output
   }
 }
 
+void CheckNotReserved(const std::string& option, const std::string& path,
+                      const std::vector<std::string>& reserved, const std::string& owner) {
+  if (path.empty()) return;
+  namespace fs = std::filesystem;
+  const auto normal = [](const std::string& name) {
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(fs::absolute(name), error);
+    return error ? fs::absolute(name).lexically_normal() : canonical;
+  };
+  const fs::path target = normal(path);
+  for (const std::string& own : reserved) {
+    if (target == normal(own)) {
+      std::string message = option;
+      message += " " + path;
+      message += ": is " + owner;
+      message += " " + own;
+      message += "; writing the JSON there would replace it";
+      throw std::invalid_argument(message);
+    }
+  }
+}
+
 ScanRange ParseScanRange(const std::string& text, std::size_t count) {
   const auto colon = text.find(':');
   if (colon == std::string::npos) {

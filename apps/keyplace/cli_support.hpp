@@ -56,6 +56,12 @@ ScanRange ParseScanRange(const std::string& text, std::size_t count);
 void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
                   const std::vector<std::string>& inputs);
 
+/// Refuses `path` (given to `option`) when it names one of `reserved`, the files a command keeps
+/// in its own output directory (a sweep's resume identity, a report's page), whether they exist
+/// yet or not: writing the JSON there would replace them.
+void CheckNotReserved(const std::string& option, const std::string& path,
+                      const std::vector<std::string>& reserved, const std::string& owner);
+
 /// The outputs of --grid FILE.yaml: the YAML and its image (MapServerImagePath), for CheckOutputs;
 /// none when `yaml_path` is empty.
 std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path);

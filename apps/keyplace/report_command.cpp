@@ -61,6 +61,7 @@ int Report(ReportOptions options, const std::string& json_path) {
   const auto start = std::chrono::steady_clock::now();
   if (options.data_dir.empty()) options.data_dir = DefaultDataDir();
   CheckOutputs({{"--json", json_path}}, {});
+  CheckNotReserved("--json", json_path, {options.out_dir + "/index.html"}, "the report's page");
   // This very executable, even if its file is replaced by a rebuild while the report runs.
   const ReportSummary summary = RunReport(options, "/proc/self/exe");
   fmt::print(

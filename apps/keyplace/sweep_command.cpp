@@ -105,9 +105,19 @@ Config ResolveSweepConfig(const SweepOptions& options) {
   });
 }
 
+// The JSON must not be the log, nor one of the files the sweep keeps in --out (its resume
+// identity and results), which it would replace.
+void CheckSweepOutputs(const SweepOptions& options) {
+  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
+  const std::string dir = options.out_dir;
+  CheckNotReserved("--json", options.json_path,
+                   {dir + "/sweep.json", dir + "/results.csv", dir + "/results.json"},
+                   "the sweep's own file");
+}
+
 void RunSweepMapping(const SweepOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
+  CheckSweepOutputs(options);
   const std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                                    {"l_g", ParseValueList(options.l_g, "--lg")}};
   const std::vector<std::vector<double>> grid = ExpandGrid(axes);
@@ -138,7 +148,7 @@ void RunSweepMapping(const SweepOptions& options) {
 
 void RunSweepPlace(const SweepOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
+  CheckSweepOutputs(options);
   if (options.n_pos < 1) throw std::invalid_argument("--n-pos must be >= 1");
   std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                              {"l_g", ParseValueList(options.l_g, "--lg")},

@@ -120,6 +120,23 @@ if "$keyplace" sweep place --map-log "$log" --scans 0:200 --n-pos 40 --out "$wor
   cat "$work/out"
 fi
 
+# --json onto one of the sweep's own files (its resume identity) is refused before any work, and
+# the file stays as it was.
+cp "$work/mapping-ref/sweep.json" "$work/identity-before.json"
+for own in sweep.json results.csv results.json; do
+  if "$keyplace" sweep mapping --log "$log" --scans 0:50 --s-min 0.2 --out "$work/mapping-ref" \
+    --json "$work/mapping-ref/$own" >"$work/out" 2>&1; then fail "--json $own in --out accepted"; elif
+    grep -q "is the sweep's own file" "$work/out"; then ok; else
+    fail "--json $own: refusal message"
+    cat "$work/out"
+  fi
+done
+if [ -f "$work/identity-before.json" ]; then
+  if cmp -s "$work/mapping-ref/sweep.json" "$work/identity-before.json"; then ok; else
+    fail "the refused --json changed the sweep's identity"
+  fi
+fi
+
 # Bad value lists.
 for bad in "0:1" "0:1:0" "1:0:0.1" "0.1,x" "" "0.1,0.1"; do
   if "$keyplace" sweep mapping --log "$log" --scans 0:50 --s-min "$bad" --out "$work/bad" \
