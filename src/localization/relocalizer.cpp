@@ -92,14 +92,9 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
     update.confidence = fix_confidence_;
     update.unconfirmed_m = odometry_m_ - confirmed_at_m_;
     // The filter's own uncertainty now: the fix's variance plus the drift allowance since its
-    // last confirmation. Heading is fused with the same weights (Confirm), so its variance is
-    // the answers' heading variance (agree_deg / 2, one sigma) scaled alike.
-    const double drift_m = policy_.agree_per_m * update.unconfirmed_m;
-    const double answer_variance_m2 = 0.25 * policy_.agree_m * policy_.agree_m;
-    const double answer_heading_sigma_rad = 0.5 * policy_.agree_deg * kRadPerDeg;
-    update.position_variance_m2 = fix_variance_m2_ + drift_m * drift_m;
-    update.heading_variance_rad2 = update.position_variance_m2 / answer_variance_m2 *
-                                   answer_heading_sigma_rad * answer_heading_sigma_rad;
+    // last confirmation.
+    update.position_variance_m2 = fix_variance_m2_ + DriftVarianceM2();
+    update.heading_variance_rad2 = HeadingVarianceFor(update.position_variance_m2);
     // The matches' covariance, carried here, plus the map's own error (not fused away: every
     // answer in one place shares it).
     update.covariance = FixCovarianceAt(T_odom_robot);
@@ -123,14 +118,26 @@ Eigen::Matrix3d FixFilter::FixCovarianceAt(const Pose2& T_odom_robot) const {
   jacobian(0, 2) = -moved_m.y();
   jacobian(1, 2) = moved_m.x();
   Eigen::Matrix3d covariance = jacobian * fix_covariance_ * jacobian.transpose();
-  const double drift_m = policy_.agree_per_m * (odometry_m_ - confirmed_at_m_);
-  const double answer_sigma_m = 0.5 * policy_.agree_m;
-  const double answer_heading_sigma_rad = 0.5 * policy_.agree_deg * kRadPerDeg;
-  const double heading_drift_rad = drift_m / answer_sigma_m * answer_heading_sigma_rad;
-  covariance(0, 0) += drift_m * drift_m;
-  covariance(1, 1) += drift_m * drift_m;
-  covariance(2, 2) += heading_drift_rad * heading_drift_rad;
+  const double drift_m2 = DriftVarianceM2();
+  covariance(0, 0) += drift_m2;
+  covariance(1, 1) += drift_m2;
+  covariance(2, 2) += HeadingVarianceFor(drift_m2);
   return covariance;
+}
+
+// The drift allowance since the last confirmation, (agree_per_m * distance)^2 per position
+// coordinate.
+double FixFilter::DriftVarianceM2() const {
+  const double drift_m = policy_.agree_per_m * (odometry_m_ - confirmed_at_m_);
+  return drift_m * drift_m;
+}
+
+// Heading is fused with the same weights as position (Confirm), so a position variance comes
+// with the answers' heading variance (agree_deg / 2, one sigma) scaled as their position
+// variance (agree_m / 2).
+double FixFilter::HeadingVarianceFor(double position_variance_m2) const {
+  const double heading_per_position = (policy_.agree_deg * kRadPerDeg) / policy_.agree_m;
+  return position_variance_m2 * heading_per_position * heading_per_position;
 }
 
 void FixFilter::Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,

@@ -110,6 +110,8 @@ class FixFilter {
   void DeclareLost(RelocalizationUpdate& update);
   // fix_covariance_ carried to the robot's odometry pose T_odom_robot, plus the drift allowance.
   Eigen::Matrix3d FixCovarianceAt(const Pose2& T_odom_robot) const;
+  double DriftVarianceM2() const;
+  double HeadingVarianceFor(double position_variance_m2) const;
 
   FixPolicy policy_;
   FixStatus status_ = FixStatus::kSearching;
