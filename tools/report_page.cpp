@@ -14,17 +14,7 @@ namespace keyplace::cli {
 namespace {
 
 std::string StateText(StepState state) {
-  switch (state) {
-    case StepState::kDone:
-      return "done before";
-    case StepState::kRan:
-      return "ran";
-    case StepState::kFailed:
-      return "failed";
-    case StepState::kSkipped:
-      return "skipped";
-  }
-  return "";
+  return state == StepState::kDone ? "done before" : StepStateName(state);
 }
 
 std::string CommandsSection(const ReportContext& context) {

@@ -435,4 +435,18 @@ std::vector<StepOutcome> RunSteps(const ReportSettings& settings,
   return outcomes;
 }
 
+std::string StepStateName(StepState state) {
+  switch (state) {
+    case StepState::kDone:
+      return "done";
+    case StepState::kRan:
+      return "ran";
+    case StepState::kFailed:
+      return "failed";
+    case StepState::kSkipped:
+      return "skipped";
+  }
+  return "";
+}
+
 }  // namespace keyplace::cli

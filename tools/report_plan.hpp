@@ -72,6 +72,9 @@ std::string CommandLine(const ReportStep& step);
 
 enum class StepState { kDone, kRan, kFailed, kSkipped };
 
+/// "done" (before this run), "ran", "failed" or "skipped".
+std::string StepStateName(StepState state);
+
 struct StepOutcome {
   StepState state = StepState::kSkipped;
   std::string message;  // why skipped / failed (names the missing file or the log file)

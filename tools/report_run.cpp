@@ -77,10 +77,7 @@ ReportSummary RunReport(const ReportOptions& options, const std::string& program
     summary.failed_steps += o.state == StepState::kFailed;
     ReportStepSummary step;
     step.id = context.steps[i].id;
-    step.state = o.state == StepState::kDone     ? "done"
-                 : o.state == StepState::kRan    ? "ran"
-                 : o.state == StepState::kFailed ? "failed"
-                                                 : "skipped";
+    step.state = StepStateName(o.state);
     step.command = CommandLine(context.steps[i]);
     step.message = o.message;
     step.seconds = o.seconds;
