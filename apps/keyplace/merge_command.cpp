@@ -13,6 +13,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "eval_json.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/merge_evaluation.hpp"
 #include "keyplace/localization/map_merge.hpp"
@@ -68,15 +69,16 @@ void PrintEvaluation(const MergeEvaluation& evaluation) {
       alone.rotation_max_deg);
 }
 
-// Mean and max of an error list, null when the list is empty.
-nlohmann::json StatsJson(const ErrorStats& stats) {
-  const auto value = [&](double x) {
-    return stats.count == 0 ? nlohmann::json() : nlohmann::json(x);
-  };
-  return {{"translation_mean_m", value(stats.translation_mean_m)},
-          {"translation_max_m", value(stats.translation_max_m)},
-          {"rotation_mean_deg", value(stats.rotation_mean_deg)},
-          {"rotation_max_deg", value(stats.rotation_max_deg)}};
+// StatsJson (eval_json.hpp) with every figure null when there is none: an empty mean is not a
+// perfect merge.
+nlohmann::json ErrorsJson(const ErrorStats& stats) {
+  nlohmann::json json = StatsJson(stats);
+  if (stats.count == 0) {
+    for (auto& [key, value] : json.items()) {
+      if (key != "count") value = nullptr;
+    }
+  }
+  return json;
 }
 
 nlohmann::json PlacementJson(const MergePlacementError& placement) {
@@ -102,10 +104,9 @@ nlohmann::json EvaluationJson(const MergeCommandOptions& options,
   json["index"] = options.index_path;
   json["at_origins"] = PlacementJson(evaluation.at_origins);
   const ErrorStats& stats = evaluation.at_recognitions_stats;
-  json["at_recognitions"] = StatsJson(stats);
-  json["at_recognitions"]["count"] = stats.count;
+  json["at_recognitions"] = ErrorsJson(stats);
   json["at_recognitions"]["without_truth"] = evaluation.recognitions_without_truth;
-  json["recognitions_alone"] = StatsJson(evaluation.recognitions_alone_stats);
+  json["recognitions_alone"] = ErrorsJson(evaluation.recognitions_alone_stats);
   nlohmann::json items = nlohmann::json::array();
   for (const MergePlacementError& placement : evaluation.at_recognitions) {
     items.push_back(PlacementJson(placement));
