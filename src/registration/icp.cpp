@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 
@@ -225,9 +226,30 @@ bool IcpTarget::Nearest(const Eigen::Vector2d& query, std::size_t* index,
 // ------------------------------------------------------------------------------------------
 // Alignment
 
+namespace {
+
+// The Gauss-Newton step of the points' normal equations (H, g) with the prior added. The prior's
+// information is positive definite, so the sum is too and every direction is updated.
+Eigen::Vector3d PriorStep(const Eigen::Matrix3d& H, const Eigen::Vector3d& g,
+                          const Eigen::Vector3d& pose, const IcpPosePrior& prior) {
+  const Pose2& mean = prior.T_target_source_mean;
+  const Eigen::Vector3d error(pose(0) - mean.x, pose(1) - mean.y, WrapAngle(pose(2) - mean.theta));
+  const Eigen::Matrix3d H_total = H + prior.information;
+  const Eigen::Vector3d g_total = g + prior.information * error;
+  return -H_total.ldlt().solve(g_total);
+}
+
+}  // namespace
+
 IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
-                           const Pose2& T_target_source_guess, const IcpConfig& config) {
+                           const Pose2& T_target_source_guess, const IcpConfig& config,
+                           const IcpPosePrior* prior) {
   ValidateIcpConfig(config);
+  if (prior != nullptr && (!prior->information.allFinite() ||
+                           !prior->information.isApprox(prior->information.transpose()) ||
+                           prior->information.llt().info() != Eigen::Success)) {
+    throw std::invalid_argument("IcpPosePrior.information must be symmetric positive definite");
+  }
   IcpResult result;
   result.T_target_source = T_target_source_guess;
   result.num_source_points = static_cast<int>(source.size());
@@ -294,7 +316,9 @@ IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vec
     }
     result.degenerate = held > 0;
     result.min_information_eigenvalue = lambda(0) / count;
-    if (held == 3) {
+    if (prior != nullptr) {
+      delta = PriorStep(H, g, Eigen::Vector3d(x, y, theta), *prior);
+    } else if (held == 3) {
       singular = true;
       break;
     }

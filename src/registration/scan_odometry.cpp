@@ -20,6 +20,23 @@ void Require(bool condition, const char* field, const char* what) {
   }
 }
 
+// The odometry increment as a prior on the laser pose predicted from it (docs/REGISTRATION.md,
+// "Odometry prior").
+IcpPosePrior OdometryPrior(const Pose2& predicted_T_world_laser, const Pose2& odometry_increment,
+                           const ScanOdometryConfig& c) {
+  const double step_m = TranslationNorm(odometry_increment);
+  const double sigma_m = c.prior_sigma_base_m + c.prior_sigma_per_m * step_m;
+  const double sigma_rad = c.prior_sigma_base_rad +
+                           c.prior_sigma_per_rad * std::abs(odometry_increment.theta) +
+                           c.prior_sigma_rad_per_m * step_m;
+  const double point_variance = c.prior_point_sigma_m * c.prior_point_sigma_m;
+  IcpPosePrior prior;
+  prior.T_target_source_mean = predicted_T_world_laser;
+  prior.information.diagonal() << point_variance / (sigma_m * sigma_m),
+      point_variance / (sigma_m * sigma_m), point_variance / (sigma_rad * sigma_rad);
+  return prior;
+}
+
 void RecordIcp(const IcpResult& icp, ScanOdometryResult* result) {
   result->icp_status = icp.status;
   result->iterations = icp.iterations;
@@ -76,6 +93,18 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
       2.0 * std::floor(c.recovery_window_translation_m / c.recovery_step_translation_m) + 1.0;
   const double rotations =
       2.0 * std::floor(c.recovery_window_rotation_rad / c.recovery_step_rotation_rad) + 1.0;
+  Require(std::isfinite(c.prior_point_sigma_m) && c.prior_point_sigma_m > 0.0,
+          "prior_point_sigma_m", "must be finite and > 0");
+  Require(std::isfinite(c.prior_sigma_base_m) && c.prior_sigma_base_m > 0.0, "prior_sigma_base_m",
+          "must be finite and > 0");
+  Require(std::isfinite(c.prior_sigma_per_m) && c.prior_sigma_per_m >= 0.0, "prior_sigma_per_m",
+          "must be finite and >= 0");
+  Require(std::isfinite(c.prior_sigma_base_rad) && c.prior_sigma_base_rad > 0.0,
+          "prior_sigma_base_rad", "must be finite and > 0");
+  Require(std::isfinite(c.prior_sigma_per_rad) && c.prior_sigma_per_rad >= 0.0,
+          "prior_sigma_per_rad", "must be finite and >= 0");
+  Require(std::isfinite(c.prior_sigma_rad_per_m) && c.prior_sigma_rad_per_m >= 0.0,
+          "prior_sigma_rad_per_m", "must be finite and >= 0");
   Require(translations * translations * rotations <= kMaxRecoveryPoses,
           "recovery_window_translation_m",
           "and the other recovery_window_* / recovery_step_* fields give more than 1 000 000 "
@@ -209,8 +238,11 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     } else {
       const std::vector<Eigen::Vector2d> source =
           SubsampleBySpacing(points, config_.source_min_spacing_m);
-      const IcpResult icp =
-          AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
+      const bool with_prior = config_.odometry_prior && T_odom_robot.has_value();
+      const IcpPosePrior prior =
+          OdometryPrior(predicted_T_world_laser, odometry_increment, config_);
+      const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp,
+                                             with_prior ? &prior : nullptr);
       RecordIcp(icp, &result);
       if (!icp.converged) {
         result.status = icp.status == IcpStatus::kTooFewPoints

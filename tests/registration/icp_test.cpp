@@ -147,6 +147,80 @@ TEST(IcpTest, DegenerateCorridorStaysAtGuessAlongTheAxis) {
   EXPECT_NEAR(T_world_estimate.theta, T_world_source.theta, DegToRad(0.3));
 }
 
+// A prior of information sigma_r^2 / sigma^2 per axis (IcpPosePrior's units).
+IcpPosePrior PriorAt(const Pose2& mean, double sigma_m, double sigma_rad, double sigma_r_m) {
+  IcpPosePrior prior;
+  prior.T_target_source_mean = mean;
+  const double v = sigma_r_m * sigma_r_m;
+  prior.information.diagonal() << v / (sigma_m * sigma_m), v / (sigma_m * sigma_m),
+      v / (sigma_rad * sigma_rad);
+  return prior;
+}
+
+TEST(IcpTest, PriorDecidesTheCorridorAxisAndThePointsTheRest) {
+  const auto world = testing::Corridor(1.0);
+  std::mt19937 rng(3);
+  ScanOptions options;
+  options.max_range_m = 10.0;  // the corridor ends are out of range
+  options.range_noise_m = 0.01;
+  const Pose2 T_world_target(0.0, 0.1, 0.02);
+  const Pose2 T_world_source(0.5, -0.05, 0.06);
+  const Pair pair = MakePair(world, T_world_target, T_world_source, options, &rng);
+  const IcpConfig config;
+  const IcpTarget target(pair.target, config);
+  // The guess is 0.2 m short along the axis and off across it; the prior's mean is 0.45 m along.
+  const Pose2 T_world_guess(0.3, 0.03, 0.0);
+  const Pose2 T_world_mean(0.45, 0.03, 0.0);
+  const IcpPosePrior prior =
+      PriorAt(Between(T_world_target, T_world_mean), 0.05, DegToRad(5.0), 0.05);
+  const IcpResult result =
+      AlignPointToLine(target, pair.source, Between(T_world_target, T_world_guess), config, &prior);
+  EXPECT_TRUE(result.degenerate);  // the points alone would hold the axis
+  ASSERT_TRUE(result.converged) << ToString(result.status);
+  const Pose2 T_world_estimate = T_world_target * result.T_target_source;
+  // Along the axis the prior's mean, not the guess; across it and in heading the walls.
+  EXPECT_NEAR(T_world_estimate.x, T_world_mean.x, 0.02);
+  EXPECT_NEAR(T_world_estimate.y, T_world_source.y, 0.01);
+  EXPECT_NEAR(T_world_estimate.theta, T_world_source.theta, DegToRad(0.3));
+}
+
+TEST(IcpTest, WeakPriorBarelyMovesAWellMeasuredPose) {
+  const auto world = testing::IrregularRoom();
+  const Pair pair = MakePair(world, Pose2(0.2, -0.3, 0.1), Pose2(0.45, -0.1, 0.16), {}, nullptr);
+  const IcpConfig config;
+  const IcpTarget target(pair.target, config);
+  const Pose2 guess = pair.T_target_source * Pose2(0.12, -0.09, DegToRad(4.0));
+  // Odometry 10 cm and 3 degrees off, with a 5 cm / 2 degree standard deviation.
+  const Pose2 mean = pair.T_target_source * Pose2(0.1, 0.0, DegToRad(3.0));
+  const IcpPosePrior prior = PriorAt(mean, 0.05, DegToRad(2.0), 0.05);
+  const IcpResult with_prior = AlignPointToLine(target, pair.source, guess, config, &prior);
+  ASSERT_TRUE(with_prior.converged) << ToString(with_prior.status);
+  const PoseError error = ErrorOf(with_prior.T_target_source, pair.T_target_source);
+  EXPECT_LT(error.translation_m, 3e-3);
+  EXPECT_LT(error.rotation_deg, 0.1);
+  // A prior that is as sure as the points pulls the estimate visibly towards its mean.
+  const IcpPosePrior strong = PriorAt(mean, 0.002, DegToRad(0.1), 0.05);
+  const IcpResult pulled = AlignPointToLine(target, pair.source, guess, config, &strong);
+  EXPECT_GT(ErrorOf(pulled.T_target_source, pair.T_target_source).translation_m, 0.02);
+}
+
+TEST(IcpTest, PriorMustBePositiveDefinite) {
+  const auto world = testing::IrregularRoom();
+  const Pair pair = MakePair(world, Pose2(), Pose2(0.1, 0.0, 0.0), {}, nullptr);
+  const IcpConfig config;
+  const IcpTarget target(pair.target, config);
+  IcpPosePrior prior;  // zero information
+  EXPECT_THROW(AlignPointToLine(target, pair.source, Pose2(), config, &prior),
+               std::invalid_argument);
+  prior.information = Eigen::Matrix3d::Identity();
+  prior.information(0, 1) = 0.5;  // not symmetric
+  EXPECT_THROW(AlignPointToLine(target, pair.source, Pose2(), config, &prior),
+               std::invalid_argument);
+  prior.information = Eigen::Matrix3d::Identity() * std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(AlignPointToLine(target, pair.source, Pose2(), config, &prior),
+               std::invalid_argument);
+}
+
 TEST(IcpTest, EmptyAndTinyInputsGiveAClearResult) {
   const auto world = testing::IrregularRoom();
   const std::vector<Eigen::Vector2d> room = Endpoints(CastScan(world, Pose2(), ScanOptions{}));

@@ -87,6 +87,80 @@ TEST(ScanOdometryTest, CorrectsDriftingOdometryInARoom) {
   EXPECT_LT(worst_deg, 0.5);
 }
 
+// The odometry prior is passed to ICP with the odometry's increment, and only with odometry: an
+// (absurdly) certain prior keeps every pose at the drifting odometry's prediction, the default
+// sigmas let the room's walls correct the drift, and without odometry there is no prior to keep.
+TEST(ScanOdometryTest, OdometryPriorWeighsTheOdometryAgainstTheScans) {
+  const auto world = testing::IrregularRoom();
+  ScanOptions options;
+  options.beams = 180;
+  options.fov_rad = M_PI;
+  options.range_noise_m = 0.01;
+  const Drive drive = MakeDrive(world, 30, Pose2(0.1, 0.0, DegToRad(4.5)), Pose2(0.5, -1.1, 0.0),
+                                Pose2(), options, 5);
+  auto worst_error_m = [&](const ScanOdometryConfig& config, bool with_odometry,
+                           double* worst_from_prediction_m) {
+    ScanOdometry odometry(config);
+    double worst = 0.0;
+    *worst_from_prediction_m = 0.0;
+    Pose2 first;  // without odometry the world is the first scan's frame: compare from there
+    for (std::size_t i = 0; i < drive.scans.size(); ++i) {
+      const std::optional<Pose2> odometry_pose =
+          with_odometry ? drive.scans[i].odometry_pose : std::nullopt;
+      const ScanOdometryResult result = odometry.Add(drive.scans[i], odometry_pose);
+      if (i == 0) first = result.T_world_robot;
+      const Pose2 truth = Between(drive.truth_robot[0], drive.truth_robot[i]);
+      worst =
+          std::max(worst, TranslationNorm(Between(truth, Between(first, result.T_world_robot))));
+      *worst_from_prediction_m = std::max(
+          *worst_from_prediction_m,
+          TranslationNorm(Between(result.T_world_robot_odometry_prediction, result.T_world_robot)));
+    }
+    return worst;
+  };
+  ScanOdometryConfig with_prior;
+  with_prior.odometry_prior = true;
+  double moved_default = 0.0;
+  const double error_default = worst_error_m(with_prior, true, &moved_default);
+  EXPECT_LT(error_default, 0.03);
+  ScanOdometryConfig certain = with_prior;
+  certain.prior_sigma_base_m = 1e-5;
+  certain.prior_sigma_per_m = 0.0;
+  certain.prior_sigma_base_rad = 1e-6;
+  certain.prior_sigma_per_rad = 0.0;
+  certain.prior_sigma_rad_per_m = 0.0;
+  double moved_certain = 0.0;
+  const double error_certain = worst_error_m(certain, true, &moved_certain);
+  EXPECT_LT(moved_certain, 1e-3);  // every pose at the prediction
+  EXPECT_GT(error_certain, 0.1);   // so the odometry's drift stays
+  EXPECT_GT(moved_default, 10.0 * moved_certain);
+  double moved_without_odometry = 0.0;
+  EXPECT_LT(worst_error_m(certain, false, &moved_without_odometry), 0.03);
+  certain.odometry_prior = false;
+  EXPECT_LT(worst_error_m(certain, true, &moved_default), 0.03);
+}
+
+TEST(ScanOdometryTest, OdometryPriorConfigIsValidated) {
+  for (const auto& [field, set] :
+       std::vector<std::pair<std::string, void (*)(ScanOdometryConfig&)>>{
+           {"prior_point_sigma_m", [](ScanOdometryConfig& c) { c.prior_point_sigma_m = 0.0; }},
+           {"prior_sigma_base_m", [](ScanOdometryConfig& c) { c.prior_sigma_base_m = -1.0; }},
+           {"prior_sigma_per_m", [](ScanOdometryConfig& c) { c.prior_sigma_per_m = NAN; }},
+           {"prior_sigma_base_rad", [](ScanOdometryConfig& c) { c.prior_sigma_base_rad = 0.0; }},
+           {"prior_sigma_per_rad", [](ScanOdometryConfig& c) { c.prior_sigma_per_rad = -0.1; }},
+           {"prior_sigma_rad_per_m",
+            [](ScanOdometryConfig& c) { c.prior_sigma_rad_per_m = INFINITY; }}}) {
+    ScanOdometryConfig config;
+    set(config);
+    try {
+      ValidateScanOdometryConfig(config);
+      ADD_FAILURE() << field << " was accepted";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+    }
+  }
+}
+
 TEST(ScanOdometryTest, CorridorDoesNotSlideAwayFromOdometry) {
   const auto world = testing::Corridor(1.0);
   ScanOptions options;

@@ -140,10 +140,24 @@ class IcpTarget {
   std::unique_ptr<Impl> impl_;
 };
 
+/// A Gaussian prior on the estimated pose, such as the wheel odometry's prediction: the cost gains
+/// e^T information e / 2 with e = (x, y, theta) of the estimate minus those of the mean, in the
+/// target frame. The information is in the units of the point-to-line cost, where one point with
+/// residual r costs r^2 / 2 (m^2): a prior of standard deviation sigma, for residuals of standard
+/// deviation sigma_r, has information sigma_r^2 / sigma^2 (rotation: m^2 / rad^2).
+struct IcpPosePrior {
+  Pose2 T_target_source_mean;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+};
+
 /// Aligns `source` (points in the source frame) to `target`, starting from T_target_source_guess.
 /// Expected failures are reported in the result; the config is validated (std::invalid_argument).
+/// With a prior the normal equations include it and no direction is held by the degeneracy guard
+/// (the prior is what keeps a weakly measured direction near its mean); `degenerate` still reports
+/// whether the points alone would have been held.
 IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
-                           const Pose2& T_target_source_guess, const IcpConfig& config);
+                           const Pose2& T_target_source_guess, const IcpConfig& config,
+                           const IcpPosePrior* prior = nullptr);
 
 /// Throws std::invalid_argument naming the first invalid field of `config`.
 void ValidateIcpConfig(const IcpConfig& config);

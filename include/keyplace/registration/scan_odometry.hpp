@@ -57,6 +57,25 @@ struct ScanOdometryConfig {
   double recovery_window_rotation_rad = 0.7853981634;  // 45 deg
   double recovery_step_translation_m = 0.1;
   double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
+
+  // The odometry as a prior of ICP. ICP from the prediction adds the odometry increment as a
+  // Gaussian prior on the pose (IcpPosePrior): where the scan measures the pose well the points
+  // decide, and along a direction they barely constrain (a long corridor whose far walls are too
+  // sparse for normals) the odometry does, instead of nearest-neighbour associations sliding the
+  // pose along it. The odometry's standard deviation for one step grows with the step:
+  // translation prior_sigma_base_m + prior_sigma_per_m |step|, rotation prior_sigma_base_rad +
+  // prior_sigma_per_rad |turn| + prior_sigma_rad_per_m |step|; prior_point_sigma_m, the standard
+  // deviation of a point-to-line residual, sets the scale between the two. Only with odometry,
+  // and not for the retry of the recovery search (the prediction is suspect there). Off by
+  // default: it did not make SLAM better on the development logs and broke the hospital bag's
+  // (docs/REGISTRATION.md, "Odometry prior").
+  bool odometry_prior = false;
+  double prior_point_sigma_m = 0.05;
+  double prior_sigma_base_m = 0.03;
+  double prior_sigma_per_m = 0.1;
+  double prior_sigma_base_rad = 0.05;  // 2.9 deg
+  double prior_sigma_per_rad = 0.3;
+  double prior_sigma_rad_per_m = 0.1;
 };
 
 /// Throws std::invalid_argument naming the first invalid field (including icp.*).
