@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <tbb/parallel_for.h>
 #include <nanoflann.hpp>
 
 namespace keyplace {
@@ -38,8 +39,15 @@ namespace {
 constexpr double kPseudoZero = std::numeric_limits<double>::min();  // as SymmetricChi2
 constexpr double kRadiusSlack = 1e-9;
 
-// At most this many doubles for the query-by-keypoint product of kDense (4 MiB).
+// At most this many doubles for the query-by-keypoint product of kDense (4 MiB), per thread.
 constexpr std::size_t kProductBudget = std::size_t{1} << 19;
+// kDense splits larger maps into at least this many blocks of places (searched in parallel), of
+// at least kMinBlockKeypoints keypoints each (smaller products lose their speed per keypoint).
+// Only the data sizes decide the blocks, never the threads.
+constexpr std::size_t kMinBlocks = 8;
+constexpr std::size_t kMinBlockKeypoints = 256;
+// kKdTree searches this many query rows per task.
+constexpr std::size_t kRowsPerTask = 8;
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -142,15 +150,15 @@ double SqrtDescriptorIndex::SearchRadius2(double chi2_threshold, double query_sq
          kRadiusSlack * (query_squared_norm + max_squared_norm_);
 }
 
-void SqrtDescriptorIndex::AddIfBelow(const BetaGridDescriptor& query, int query_index,
-                                     std::size_t keypoint, double chi2_threshold,
-                                     std::vector<std::vector<DescriptorPair>>& below) const {
+bool SqrtDescriptorIndex::PairIfBelow(const BetaGridDescriptor& query, int query_index,
+                                      std::size_t keypoint, double chi2_threshold,
+                                      DescriptorPair& pair) const {
   const double distance = SymmetricChi2IfBelow(query, descriptors_[keypoint], chi2_threshold);
-  if (!(distance < chi2_threshold)) return;  // +inf: not below
+  if (!(distance < chi2_threshold)) return false;  // +inf: not below
   const int place = place_of_[keypoint];
-  below[static_cast<std::size_t>(place)].push_back(
-      {query_index, static_cast<int>(keypoint) - first_of_place_[static_cast<std::size_t>(place)],
-       distance});
+  pair = {query_index,
+          static_cast<int>(keypoint) - first_of_place_[static_cast<std::size_t>(place)], distance};
+  return true;
 }
 
 void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query,
@@ -171,24 +179,40 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
   const Eigen::VectorXd query_norms = query_roots.rowwise().squaredNorm();
 
   if (kind_ == PlaceRecognitionConfig::DescriptorIndex::kKdTree) {
-    std::vector<std::pair<std::size_t, double>> found;
-    std::vector<std::pair<std::size_t, double>> in_tree;
-    for (std::size_t c = 0; c < query.size(); ++c) {
-      const auto row = static_cast<Eigen::Index>(c);
-      const double radius2 = SearchRadius2(chi2_threshold, query_norms[row]);
-      found.clear();
-      for (const auto& tree : trees_) {
-        tree->tree.radiusSearch(query_roots.row(row).data(), radius2, in_tree,
-                                nanoflann::SearchParams(32, 0.0f, false));
-        for (const auto& [local, distance2] : in_tree) {
-          found.emplace_back(tree->adaptor.begin + local, distance2);
+    // Blocks of query rows in parallel (TBB), each listing its pairs, then appended to the places'
+    // lists in row order.
+    const std::size_t n_tasks = (query.size() + kRowsPerTask - 1) / kRowsPerTask;
+    std::vector<std::vector<std::pair<int, DescriptorPair>>> found_by_task(
+        n_tasks);  // (place, pair)
+    tbb::parallel_for(std::size_t{0}, n_tasks, [&](std::size_t task) {
+      std::vector<std::pair<std::size_t, double>> found;
+      std::vector<std::pair<std::size_t, double>> in_tree;
+      const std::size_t end_row = std::min(query.size(), (task + 1) * kRowsPerTask);
+      for (std::size_t c = task * kRowsPerTask; c < end_row; ++c) {
+        const auto row = static_cast<Eigen::Index>(c);
+        const double radius2 = SearchRadius2(chi2_threshold, query_norms[row]);
+        found.clear();
+        for (const auto& tree : trees_) {
+          tree->tree.radiusSearch(query_roots.row(row).data(), radius2, in_tree,
+                                  nanoflann::SearchParams(32, 0.0f, false));
+          for (const auto& [local, distance2] : in_tree) {
+            found.emplace_back(tree->adaptor.begin + local, distance2);
+          }
+        }
+        std::sort(found.begin(), found.end());  // by keypoint: the exhaustive order
+        for (const auto& [keypoint, distance2] : found) {
+          const int place = place_of_[keypoint];
+          DescriptorPair pair;
+          if (searched[static_cast<std::size_t>(place)] &&
+              PairIfBelow(query[c], static_cast<int>(c), keypoint, chi2_threshold, pair)) {
+            found_by_task[task].emplace_back(place, pair);
+          }
         }
       }
-      std::sort(found.begin(), found.end());  // by keypoint: the exhaustive order
-      for (const auto& [keypoint, distance2] : found) {
-        if (searched[static_cast<std::size_t>(place_of_[keypoint])]) {
-          AddIfBelow(query[c], static_cast<int>(c), keypoint, chi2_threshold, below);
-        }
+    });
+    for (const auto& task_pairs : found_by_task) {
+      for (const auto& [place, pair] : task_pairs) {
+        below[static_cast<std::size_t>(place)].push_back(pair);
       }
     }
     return;
@@ -197,11 +221,14 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
   // kDense: ||u - v||^2 = ||u||^2 + ||v||^2 - 2 u.v for a block of whole places against every
   // query row at once (one matrix product), then the exact test where it is within the radius.
   // Blocks of places, not of query rows: each keypoint's roots are read from memory once per
-  // query however large the map (blocks of query rows reread the whole map per block).
+  // query however large the map (blocks of query rows reread the whole map per block). The
+  // blocks are searched in parallel (TBB); each writes only its own places' lists.
   const Eigen::Map<const RowMatrix> roots(
       roots_.data(), static_cast<Eigen::Index>(descriptors_.size()), kBetaGridBins);
-  const std::size_t block_keypoints = std::max<std::size_t>(kProductBudget / query.size(), 1);
-  Eigen::MatrixXd dots;  // keypoint of the block x query row, column-major
+  const std::size_t block_keypoints =
+      std::min(std::max<std::size_t>(kProductBudget / query.size(), 1),
+               std::max(descriptors_.size() / kMinBlocks, kMinBlockKeypoints));
+  std::vector<std::pair<std::size_t, std::size_t>> blocks;  // [first place, end place)
   for (std::size_t first_place = 0; first_place < n_places;) {
     std::size_t end_place = first_place + 1;
     const auto begin = static_cast<std::size_t>(first_of_place_[first_place]);
@@ -209,15 +236,21 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
            static_cast<std::size_t>(first_of_place_[end_place + 1]) - begin <= block_keypoints) {
       ++end_place;
     }
+    blocks.emplace_back(first_place, end_place);
+    first_place = end_place;
+  }
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t block) {
+    const auto [first_place, end_place] = blocks[block];
+    const auto begin = static_cast<std::size_t>(first_of_place_[first_place]);
     const auto count = static_cast<std::size_t>(first_of_place_[end_place]) - begin;
-    if (count > 0) {
-      dots.resize(static_cast<Eigen::Index>(count), static_cast<Eigen::Index>(query.size()));
-      dots.noalias() =
-          roots.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(count)) *
-          query_roots.transpose();
-    }
+    if (count == 0) return;
+    Eigen::MatrixXd dots(static_cast<Eigen::Index>(count),
+                         static_cast<Eigen::Index>(query.size()));  // keypoint x query row
+    dots.noalias() =
+        roots.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(count)) *
+        query_roots.transpose();
     // Per place, pairs in the exhaustive order: query keypoint, then place keypoint.
-    for (std::size_t c = 0; c < query.size() && count > 0; ++c) {
+    for (std::size_t c = 0; c < query.size(); ++c) {
       const double query_norm = query_norms[static_cast<Eigen::Index>(c)];
       const double radius2 = SearchRadius2(chi2_threshold, query_norm);
       const double* column = dots.col(static_cast<Eigen::Index>(c)).data();
@@ -225,14 +258,15 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
         if (!searched[p]) continue;
         const auto end = static_cast<std::size_t>(first_of_place_[p + 1]);
         for (auto k = static_cast<std::size_t>(first_of_place_[p]); k < end; ++k) {
-          if (squared_norms_[k] + query_norm - 2.0 * column[k - begin] < radius2) {
-            AddIfBelow(query[c], static_cast<int>(c), k, chi2_threshold, below);
+          DescriptorPair pair;
+          if (squared_norms_[k] + query_norm - 2.0 * column[k - begin] < radius2 &&
+              PairIfBelow(query[c], static_cast<int>(c), k, chi2_threshold, pair)) {
+            below[p].push_back(pair);
           }
         }
       }
     }
-    first_place = end_place;
-  }
+  });
 }
 
 }  // namespace keyplace

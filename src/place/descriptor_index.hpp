@@ -41,7 +41,8 @@ class SqrtDescriptorIndex {
   /// For every place p with searched[p] != 0: below[p] = the pairs (query index, keypoint index
   /// of place p, SymmetricChi2) with SymmetricChi2Below(query, keypoint, chi2_threshold), ordered
   /// by query index, then keypoint index. Other places' lists are left empty. `below` is resized
-  /// to the number of places; `searched` must have that size.
+  /// to the number of places; `searched` must have that size. Searches blocks of places (kDense)
+  /// or of query rows (kKdTree) in parallel (TBB), with the same result at any number of threads.
   void FindPairs(const std::vector<BetaGridDescriptor>& query, double chi2_threshold,
                  const std::vector<char>& searched,
                  std::vector<std::vector<DescriptorPair>>& below) const;
@@ -53,9 +54,10 @@ class SqrtDescriptorIndex {
   // The squared search radius in square-root space for a query row of squared norm
   // `query_squared_norm`: 2 * chi2_threshold and a margin for rounding (descriptor_index.cpp).
   double SearchRadius2(double chi2_threshold, double query_squared_norm) const;
-  // The exact test of query descriptor `query_index` against keypoint `keypoint`.
-  void AddIfBelow(const BetaGridDescriptor& query, int query_index, std::size_t keypoint,
-                  double chi2_threshold, std::vector<std::vector<DescriptorPair>>& below) const;
+  // The exact test of query descriptor `query_index` against keypoint `keypoint`: true, and
+  // `pair` (query index, keypoint index in its place, SymmetricChi2), when below the threshold.
+  bool PairIfBelow(const BetaGridDescriptor& query, int query_index, std::size_t keypoint,
+                   double chi2_threshold, DescriptorPair& pair) const;
 
   PlaceRecognitionConfig::DescriptorIndex kind_;
   std::vector<BetaGridDescriptor> descriptors_;  // every place keypoint, place-major

@@ -1,6 +1,7 @@
 #include "keyplace/place/place_recognizer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -8,6 +9,13 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "keyplace/place/ransac.hpp"
 #include "place/candidate_ranking.hpp"
@@ -342,6 +350,132 @@ void PlaceRecognizer::SetPlacePose(std::size_t place_index, const Pose2& T_world
   places_.at(place_index).T_world_place = T_world_place;
 }
 
+namespace {
+
+// A place with >= mu unique pairs (Algorithm 3), verified in the order of the candidate list.
+struct Candidate {
+  int place_index = -1;  // -1: not a candidate
+  double mean_distance = 0.0;
+  std::vector<DescriptorPair> pairs;
+};
+
+// Grain sizes of the parallel loops of Recognize (TBB): places of the unique pairs per task
+// (microseconds each with an index), candidates of LargestRigidStar per task (O(pairs^2) each).
+// Candidates are verified one per task (a RANSAC each).
+constexpr std::size_t kPlacesPerTask = 16;
+constexpr std::size_t kRankedCandidatesPerTask = 4;
+
+// What the verification of every candidate of one query reads.
+struct Verification {
+  const std::vector<Place>& places;
+  const PlaceRecognitionConfig& config;
+  const PlaceQuery& query;
+  const std::vector<Eigen::Vector2d>& match_positions;  // the query keypoints paired
+  double min_gamma;
+  double min_coverage;
+};
+
+// The map neighbours of places[place_index] (ids adjacent to its own, within
+// verification_neighbours, in offset order) that `exclude` lets through.
+std::vector<int> VerificationNeighbours(const std::vector<Place>& places, int place_index,
+                                        int verification_neighbours,
+                                        const PlaceExclusion& exclude) {
+  std::vector<int> neighbours;
+  const Place& place = places[static_cast<std::size_t>(place_index)];
+  const int count = static_cast<int>(places.size());
+  for (int offset = -verification_neighbours; offset <= verification_neighbours; ++offset) {
+    const int n = place_index + offset;
+    if (offset == 0 || n < 0 || n >= count) continue;
+    const Place& neighbour = places[static_cast<std::size_t>(n)];
+    if (neighbour.id != place.id + offset) continue;  // not adjacent in the map
+    if (exclude && exclude(neighbour)) continue;
+    neighbours.push_back(n);
+  }
+  return neighbours;
+}
+
+// RANSAC and the three checks of one candidate (the place's own seed: the answer does not depend
+// on which other candidates are verified, nor in which order). nullopt: not verified.
+std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Candidate& candidate,
+                                               const std::vector<int>& neighbours) {
+  const PlaceRecognitionConfig& config = v.config;
+  const Place& place = v.places[static_cast<std::size_t>(candidate.place_index)];
+  std::vector<std::pair<int, int>> index_pairs;
+  index_pairs.reserve(candidate.pairs.size());
+  for (const DescriptorPair& pair : candidate.pairs) {
+    index_pairs.emplace_back(pair.current, pair.reference);
+  }
+  RansacConfig ransac = config.ransac;
+  ransac.seed = PlaceSeed(config.ransac.seed, place.id);
+  // The reference: the candidate, then its map neighbours in its frame (pairs index the
+  // candidate's keypoints, which come first).
+  std::vector<Eigen::Vector2d> extended_positions;
+  std::vector<BetaGridDescriptor> extended_descriptors;
+  const std::vector<Eigen::Vector2d>* reference_positions = &place.positions;
+  const std::vector<BetaGridDescriptor>* reference_descriptors = &place.descriptors;
+  if (config.verification_neighbours > 0) {
+    extended_positions = place.positions;
+    extended_descriptors = place.descriptors;
+    const double merge2 = config.ransac.inlier_distance_m * config.ransac.inlier_distance_m;
+    for (int n : neighbours) {
+      const Place& neighbour = v.places[static_cast<std::size_t>(n)];
+      const Pose2 T_place_neighbour = Between(place.T_world_place, neighbour.T_world_place);
+      const std::size_t own = extended_positions.size();
+      for (std::size_t q = 0; q < neighbour.positions.size(); ++q) {
+        const Eigen::Vector2d p = T_place_neighbour * neighbour.positions[q];
+        bool duplicate = false;
+        for (std::size_t j = 0; j < own && !duplicate; ++j) {
+          duplicate = (extended_positions[j] - p).squaredNorm() < merge2;
+        }
+        if (duplicate) continue;
+        extended_positions.push_back(p);
+        extended_descriptors.push_back(neighbour.descriptors[q]);
+      }
+    }
+    reference_positions = &extended_positions;
+    reference_descriptors = &extended_descriptors;
+  }
+  const RansacResult estimate =
+      EstimateRigidTransformRansac(*reference_positions, v.match_positions, index_pairs, ransac);
+  if (!estimate.valid) return std::nullopt;
+  const int consensus = CountConsensus(estimate.inliers, config.consensus_counting);
+  if (consensus < config.min_consensus) return std::nullopt;  // first check
+  const GammaResult gamma =
+      ComputeGamma(*reference_positions, *reference_descriptors, v.query.positions,
+                   v.query.descriptors, estimate.T_ref_cur, config.double_match_m,
+                   config.descriptor_match_chi2, config.gamma_counting);
+  if (gamma.gamma < v.min_gamma) return std::nullopt;  // second check
+  const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
+                                            estimate.T_ref_cur, config.ransac.inlier_distance_m);
+  if (coverage < v.min_coverage) return std::nullopt;  // third check (ours)
+  CandidateResult result;
+  result.place_index = candidate.place_index;
+  result.pairs = static_cast<int>(candidate.pairs.size());
+  result.mean_pair_distance = candidate.mean_distance;
+  result.consensus = consensus;
+  result.gamma = gamma.gamma;
+  result.reference_coverage = coverage;
+  result.verified = true;
+  result.T_ref_cur = estimate.T_ref_cur;
+  result.estimated_pose = place.T_world_place * estimate.T_ref_cur * v.query.T_first_evaluated;
+  result.estimated_pose_covariance = ComposedCovariance(
+      place.T_world_place, estimate.T_ref_cur, v.query.T_first_evaluated,
+      RigidFitCovariance(*reference_positions, v.match_positions, estimate.inliers,
+                         estimate.T_ref_cur, config.ransac.min_fit_sigma_m));
+  result.score = SelectionScore(config.score, consensus, gamma.gamma);
+  return result;
+}
+
+// The threads a parallel loop started here may use (the arena's, within the global control).
+std::size_t AvailableThreads() {
+  const auto arena = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const std::size_t allowed =
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  return std::max<std::size_t>(1, std::min(arena, allowed));
+}
+
+}  // namespace
+
 PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
                                       const PlaceExclusion& exclude) const {
   const auto start = Clock::now();
@@ -372,12 +506,10 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   const double min_gamma = all_scan_query ? config_.min_gamma_all_scans : config_.min_gamma;
   const double min_coverage = all_scan_query ? config_.min_reference_coverage : 0.0;
 
-  // Algorithm 3 against every place: candidates with >= mu unique pairs.
-  struct Candidate {
-    int place_index;
-    double mean_distance;
-    std::vector<DescriptorPair> pairs;
-  };
+  // Algorithm 3 against every place: candidates with >= mu unique pairs. The places, their
+  // blocks in the index and the candidates are worked on in parallel (TBB), each into its own
+  // slot, and gathered in place order: the same answer at any number of threads. `exclude` is
+  // called on this thread only.
   std::vector<Candidate> candidates;
   if (match_positions->size() >= min_pairs) {
     std::vector<char> searched(places_.size(), 0);
@@ -398,19 +530,27 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
       for (std::size_t p = 0; p < places_.size(); ++p) searched_slots[slots_[p]] = searched[p];
       index_->FindPairs(*match_descriptors, config_.descriptor_match_chi2, searched_slots, below);
     }
-    for (std::size_t p = 0; p < places_.size(); ++p) {
-      if (!searched[p]) continue;
-      const Place& place = places_[p];
-      std::vector<DescriptorPair> pairs =
-          index_ ? UniquePairs(std::move(below[slots_[p]]), match_descriptors->size(),
-                               place.descriptors.size(), config_.pair_matching)
-                 : MatchDescriptorPairs(*match_descriptors, place.descriptors,
-                                        config_.descriptor_match_chi2, config_.pair_matching);
-      if (pairs.size() < min_pairs) continue;
-      double sum = 0.0;
-      for (const DescriptorPair& pair : pairs) sum += pair.distance;
-      candidates.push_back(
-          {static_cast<int>(p), sum / static_cast<double>(pairs.size()), std::move(pairs)});
+    std::vector<Candidate> by_place(places_.size());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, places_.size(), kPlacesPerTask),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t p = range.begin(); p != range.end(); ++p) {
+            if (!searched[p]) continue;
+            const Place& place = places_[p];
+            std::vector<DescriptorPair> pairs =
+                index_ ? UniquePairs(std::move(below[slots_[p]]), match_descriptors->size(),
+                                     place.descriptors.size(), config_.pair_matching)
+                       : MatchDescriptorPairs(*match_descriptors, place.descriptors,
+                                              config_.descriptor_match_chi2, config_.pair_matching);
+            if (pairs.size() < min_pairs) continue;
+            double sum = 0.0;
+            for (const DescriptorPair& pair : pairs) sum += pair.distance;
+            by_place[p] = {static_cast<int>(p), sum / static_cast<double>(pairs.size()),
+                           std::move(pairs)};
+          }
+        });
+    for (Candidate& candidate : by_place) {
+      if (candidate.place_index >= 0) candidates.push_back(std::move(candidate));
     }
   }
   std::stable_sort(
@@ -420,13 +560,18 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   const auto max_candidates = static_cast<std::size_t>(config_.max_candidates);
   if (candidates.size() > max_candidates &&
       config_.candidate_ranking == PlaceRecognitionConfig::CandidateRanking::kRigidPairs) {
-    std::vector<int> rigid_star;
-    rigid_star.reserve(candidates.size());
-    for (const Candidate& candidate : candidates) {
-      rigid_star.push_back(LargestRigidStar(candidate.pairs, *match_positions,
-                                            places_[candidate.place_index].positions,
-                                            config_.ransac.rigidity_m2));
-    }
+    std::vector<int> rigid_star(candidates.size(), 0);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, candidates.size(), kRankedCandidatesPerTask),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const Candidate& candidate = candidates[k];
+            rigid_star[k] =
+                LargestRigidStar(candidate.pairs, *match_positions,
+                                 places_[static_cast<std::size_t>(candidate.place_index)].positions,
+                                 config_.ransac.rigidity_m2);
+          }
+        });
     std::vector<Candidate> kept;
     kept.reserve(max_candidates);
     for (std::size_t k : KeepMostRigid(rigid_star, max_candidates)) {
@@ -436,85 +581,50 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   }
   match.seconds_pairing = SecondsSince(start);
 
-  // Geometric verification of the first n_c candidates.
+  // Geometric verification of the first n_c candidates, in parallel, each into its own slot,
+  // gathered in candidate order. kFirstVerified verifies them in waves of as many as there are
+  // threads (one at a time on one thread) and stops after the wave holding the first verified
+  // one; within a wave, candidates after a verified one are skipped. The answer, and
+  // candidates_verified (those up to the first verified), are the sequential loop's.
   const auto verify_start = Clock::now();
-  RansacConfig ransac = config_.ransac;
   const std::size_t to_verify = std::min(candidates.size(), max_candidates);
-  std::vector<std::pair<int, int>> index_pairs;
-  std::vector<Eigen::Vector2d> extended_positions;
-  std::vector<BetaGridDescriptor> extended_descriptors;
-  for (std::size_t k = 0; k < to_verify; ++k) {
-    const Candidate& candidate = candidates[k];
-    const Place& place = places_[candidate.place_index];
-    ++match.candidates_verified;
-    index_pairs.clear();
-    for (const DescriptorPair& pair : candidate.pairs) {
-      index_pairs.emplace_back(pair.current, pair.reference);
-    }
-    ransac.seed = PlaceSeed(config_.ransac.seed, place.id);
-    // The reference: the candidate, then its map neighbours in its frame (pairs index the
-    // candidate's keypoints, which come first).
-    const std::vector<Eigen::Vector2d>* reference_positions = &place.positions;
-    const std::vector<BetaGridDescriptor>* reference_descriptors = &place.descriptors;
+  const bool first_verified =
+      config_.selection == PlaceRecognitionConfig::Selection::kFirstVerified;
+  const std::size_t wave =
+      first_verified ? AvailableThreads() : std::max<std::size_t>(to_verify, 1);
+  const Verification verification{places_,          config_,   query,
+                                  *match_positions, min_gamma, min_coverage};
+  bool done = false;
+  for (std::size_t begin = 0; begin < to_verify && !done; begin += wave) {
+    const std::size_t end = std::min(to_verify, begin + wave);
+    std::vector<std::vector<int>> neighbours(end - begin);
     if (config_.verification_neighbours > 0) {
-      extended_positions = place.positions;
-      extended_descriptors = place.descriptors;
-      const double merge2 = config_.ransac.inlier_distance_m * config_.ransac.inlier_distance_m;
-      const int index = candidate.place_index;
-      const int count = static_cast<int>(places_.size());
-      for (int offset = -config_.verification_neighbours; offset <= config_.verification_neighbours;
-           ++offset) {
-        const int n = index + offset;
-        if (offset == 0 || n < 0 || n >= count) continue;
-        const Place& neighbour = places_[n];
-        if (neighbour.id != place.id + offset) continue;  // not adjacent in the map
-        if (exclude && exclude(neighbour)) continue;
-        const Pose2 T_place_neighbour = Between(place.T_world_place, neighbour.T_world_place);
-        const std::size_t own = extended_positions.size();
-        for (std::size_t q = 0; q < neighbour.positions.size(); ++q) {
-          const Eigen::Vector2d p = T_place_neighbour * neighbour.positions[q];
-          bool duplicate = false;
-          for (std::size_t j = 0; j < own && !duplicate; ++j) {
-            duplicate = (extended_positions[j] - p).squaredNorm() < merge2;
-          }
-          if (duplicate) continue;
-          extended_positions.push_back(p);
-          extended_descriptors.push_back(neighbour.descriptors[q]);
-        }
+      for (std::size_t k = begin; k < end; ++k) {
+        neighbours[k - begin] = VerificationNeighbours(places_, candidates[k].place_index,
+                                                       config_.verification_neighbours, exclude);
       }
-      reference_positions = &extended_positions;
-      reference_descriptors = &extended_descriptors;
     }
-    const RansacResult estimate =
-        EstimateRigidTransformRansac(*reference_positions, *match_positions, index_pairs, ransac);
-    if (!estimate.valid) continue;
-    const int consensus = CountConsensus(estimate.inliers, config_.consensus_counting);
-    if (consensus < config_.min_consensus) continue;  // first check
-    const GammaResult gamma =
-        ComputeGamma(*reference_positions, *reference_descriptors, query.positions,
-                     query.descriptors, estimate.T_ref_cur, config_.double_match_m,
-                     config_.descriptor_match_chi2, config_.gamma_counting);
-    if (gamma.gamma < min_gamma) continue;  // second check
-    const double coverage = ReferenceCoverage(*reference_positions, *match_positions,
-                                              estimate.T_ref_cur, config_.ransac.inlier_distance_m);
-    if (coverage < min_coverage) continue;  // third check (ours)
-    CandidateResult result;
-    result.place_index = candidate.place_index;
-    result.pairs = static_cast<int>(candidate.pairs.size());
-    result.mean_pair_distance = candidate.mean_distance;
-    result.consensus = consensus;
-    result.gamma = gamma.gamma;
-    result.reference_coverage = coverage;
-    result.verified = true;
-    result.T_ref_cur = estimate.T_ref_cur;
-    result.estimated_pose = place.T_world_place * estimate.T_ref_cur * query.T_first_evaluated;
-    result.estimated_pose_covariance = ComposedCovariance(
-        place.T_world_place, estimate.T_ref_cur, query.T_first_evaluated,
-        RigidFitCovariance(*reference_positions, *match_positions, estimate.inliers,
-                           estimate.T_ref_cur, config_.ransac.min_fit_sigma_m));
-    result.score = SelectionScore(config_.score, consensus, gamma.gamma);
-    match.verified_candidates.push_back(result);
-    if (config_.selection == PlaceRecognitionConfig::Selection::kFirstVerified) break;
+    std::vector<std::optional<CandidateResult>> results(end - begin);
+    std::atomic<std::size_t> first_verified_in_wave{end};
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(begin, end, 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            if (first_verified && k > first_verified_in_wave.load()) return;
+            results[k - begin] =
+                VerifyCandidate(verification, candidates[k], neighbours[k - begin]);
+            if (!first_verified || !results[k - begin]) continue;
+            std::size_t seen = first_verified_in_wave.load();
+            while (k < seen && !first_verified_in_wave.compare_exchange_weak(seen, k)) {
+            }
+          }
+        });
+    for (std::size_t k = begin; k < end && !done; ++k) {
+      ++match.candidates_verified;
+      if (!results[k - begin]) continue;
+      match.verified_candidates.push_back(std::move(*results[k - begin]));
+      done = first_verified;
+    }
   }
   match.candidates_accepted = static_cast<int>(match.verified_candidates.size());
   match.seconds_verification = SecondsSince(verify_start);

@@ -168,7 +168,11 @@ class PlaceRecognizer {
   /// Throws std::out_of_range for an index outside places().
   void SetPlacePose(std::size_t place_index, const Pose2& T_world_place);
 
-  /// Not thread-safe with AddPlace, RemovePlace or SetPlacePose on the same recognizer.
+  /// Not thread-safe with AddPlace, RemovePlace or SetPlacePose on the same recognizer. Uses the
+  /// threads TBB allows (tbb::global_control, the calling task arena) for the pairs of blocks of
+  /// places, the candidates' ranking and their verification; every field of the answer but the
+  /// seconds_* timings is the same at any number of threads. `exclude` is called on the calling
+  /// thread only.
   PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
 
   const std::vector<Place>& places() const { return places_; }
