@@ -361,7 +361,7 @@ struct Candidate {
 
 // Grain sizes of the parallel loops of Recognize (TBB): places of the unique pairs per task
 // (microseconds each with an index), candidates of LargestRigidStar per task (O(pairs^2) each).
-// Candidates are verified one per task (a RANSAC each).
+// Candidates are verified in parallel (a RANSAC each, grain 1).
 constexpr std::size_t kPlacesPerTask = 16;
 constexpr std::size_t kRankedCandidatesPerTask = 4;
 

@@ -87,24 +87,26 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
           "recovery_step_translation_m", "must be finite and >= 0.01");
   Require(std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
           "recovery_step_rotation_rad", "must be finite and >= 0.001");
+  // The prior's information is prior_point_sigma_m^2 / sigma^2: these bounds keep it finite.
+  Require(std::isfinite(c.prior_point_sigma_m) && c.prior_point_sigma_m > 0.0 &&
+              c.prior_point_sigma_m <= 10.0,
+          "prior_point_sigma_m", "must be in (0, 10]");
+  Require(std::isfinite(c.prior_sigma_base_m) && c.prior_sigma_base_m >= 1e-6, "prior_sigma_base_m",
+          "must be finite and >= 1e-6");
+  Require(std::isfinite(c.prior_sigma_per_m) && c.prior_sigma_per_m >= 0.0, "prior_sigma_per_m",
+          "must be finite and >= 0");
+  Require(std::isfinite(c.prior_sigma_base_rad) && c.prior_sigma_base_rad >= 1e-6,
+          "prior_sigma_base_rad", "must be finite and >= 1e-6");
+  Require(std::isfinite(c.prior_sigma_per_rad) && c.prior_sigma_per_rad >= 0.0,
+          "prior_sigma_per_rad", "must be finite and >= 0");
+  Require(std::isfinite(c.prior_sigma_rad_per_m) && c.prior_sigma_rad_per_m >= 0.0,
+          "prior_sigma_rad_per_m", "must be finite and >= 0");
   // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 91 =
   // 11 011 poses (2-6 ms); this bound keeps a search under about a second.
   const double translations =
       2.0 * std::floor(c.recovery_window_translation_m / c.recovery_step_translation_m) + 1.0;
   const double rotations =
       2.0 * std::floor(c.recovery_window_rotation_rad / c.recovery_step_rotation_rad) + 1.0;
-  Require(std::isfinite(c.prior_point_sigma_m) && c.prior_point_sigma_m > 0.0,
-          "prior_point_sigma_m", "must be finite and > 0");
-  Require(std::isfinite(c.prior_sigma_base_m) && c.prior_sigma_base_m > 0.0, "prior_sigma_base_m",
-          "must be finite and > 0");
-  Require(std::isfinite(c.prior_sigma_per_m) && c.prior_sigma_per_m >= 0.0, "prior_sigma_per_m",
-          "must be finite and >= 0");
-  Require(std::isfinite(c.prior_sigma_base_rad) && c.prior_sigma_base_rad > 0.0,
-          "prior_sigma_base_rad", "must be finite and > 0");
-  Require(std::isfinite(c.prior_sigma_per_rad) && c.prior_sigma_per_rad >= 0.0,
-          "prior_sigma_per_rad", "must be finite and >= 0");
-  Require(std::isfinite(c.prior_sigma_rad_per_m) && c.prior_sigma_rad_per_m >= 0.0,
-          "prior_sigma_rad_per_m", "must be finite and >= 0");
   Require(translations * translations * rotations <= kMaxRecoveryPoses,
           "recovery_window_translation_m",
           "and the other recovery_window_* / recovery_step_* fields give more than 1 000 000 "
@@ -209,6 +211,8 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
 
   // Odometry increment of the laser since the previous scan.
   Pose2 odometry_increment;  // identity without odometry
+  const bool increment_measured = T_odom_robot.has_value() && previous_scan_had_odometry_;
+  previous_scan_had_odometry_ = T_odom_robot.has_value();
   if (T_odom_robot) {
     const Pose2 odometry_laser = *T_odom_robot * T_robot_laser;
     if (have_previous_odometry_)
@@ -238,7 +242,9 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     } else {
       const std::vector<Eigen::Vector2d> source =
           SubsampleBySpacing(points, config_.source_min_spacing_m);
-      const bool with_prior = config_.odometry_prior && T_odom_robot.has_value();
+      // Without a measured increment (no odometry now or at the previous scan) the prediction is
+      // a guess, not a measurement to be held to.
+      const bool with_prior = config_.odometry_prior && increment_measured;
       const IcpPosePrior prior =
           OdometryPrior(predicted_T_world_laser, odometry_increment, config_);
       const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp,

@@ -201,7 +201,13 @@ TEST(IcpTest, WeakPriorBarelyMovesAWellMeasuredPose) {
   // A prior that is as sure as the points pulls the estimate visibly towards its mean.
   const IcpPosePrior strong = PriorAt(mean, 0.002, DegToRad(0.1), 0.05);
   const IcpResult pulled = AlignPointToLine(target, pair.source, guess, config, &strong);
-  EXPECT_GT(ErrorOf(pulled.T_target_source, pair.T_target_source).translation_m, 0.02);
+  ASSERT_TRUE(pulled.converged) << ToString(pulled.status);
+  // Between the truth and the prior's mean, 10 cm apart: neither at the truth nor at the mean.
+  const double from_truth_m = ErrorOf(pulled.T_target_source, pair.T_target_source).translation_m;
+  const double from_mean_m = ErrorOf(pulled.T_target_source, mean).translation_m;
+  EXPECT_GT(from_truth_m, 0.02);
+  EXPECT_GT(from_mean_m, 0.005);
+  EXPECT_LT(from_truth_m + from_mean_m, 0.12);
 }
 
 TEST(IcpTest, PriorMustBePositiveDefinite) {

@@ -98,52 +98,61 @@ TEST(ScanOdometryTest, OdometryPriorWeighsTheOdometryAgainstTheScans) {
   options.range_noise_m = 0.01;
   const Drive drive = MakeDrive(world, 30, Pose2(0.1, 0.0, DegToRad(4.5)), Pose2(0.5, -1.1, 0.0),
                                 Pose2(), options, 5);
-  auto worst_error_m = [&](const ScanOdometryConfig& config, bool with_odometry,
-                           double* worst_from_prediction_m) {
+  struct Run {
+    double worst_error_m = 0.0;            // against the truth, from the first scan
+    double worst_from_prediction_m = 0.0;  // how far a pose moved from its prediction
+    int registered = 0;
+  };
+  // odometry_every: odometry on every n-th scan (1: all, 0: none).
+  auto run = [&](const ScanOdometryConfig& config, int odometry_every) {
     ScanOdometry odometry(config);
-    double worst = 0.0;
-    *worst_from_prediction_m = 0.0;
+    Run out;
     Pose2 first;  // without odometry the world is the first scan's frame: compare from there
     for (std::size_t i = 0; i < drive.scans.size(); ++i) {
-      const std::optional<Pose2> odometry_pose =
-          with_odometry ? drive.scans[i].odometry_pose : std::nullopt;
+      const bool has = odometry_every > 0 && i % static_cast<std::size_t>(odometry_every) == 0;
+      const std::optional<Pose2> odometry_pose = has ? drive.scans[i].odometry_pose : std::nullopt;
       const ScanOdometryResult result = odometry.Add(drive.scans[i], odometry_pose);
       if (i == 0) first = result.T_world_robot;
+      out.registered += result.status == ScanOdometryStatus::kRegistered ? 1 : 0;
       const Pose2 truth = Between(drive.truth_robot[0], drive.truth_robot[i]);
-      worst =
-          std::max(worst, TranslationNorm(Between(truth, Between(first, result.T_world_robot))));
-      *worst_from_prediction_m = std::max(
-          *worst_from_prediction_m,
+      out.worst_error_m = std::max(
+          out.worst_error_m, TranslationNorm(Between(truth, Between(first, result.T_world_robot))));
+      out.worst_from_prediction_m = std::max(
+          out.worst_from_prediction_m,
           TranslationNorm(Between(result.T_world_robot_odometry_prediction, result.T_world_robot)));
     }
-    return worst;
+    return out;
   };
+  const int steps = static_cast<int>(drive.scans.size()) - 1;
   ScanOdometryConfig with_prior;
   with_prior.odometry_prior = true;
-  double moved_default = 0.0;
-  const double error_default = worst_error_m(with_prior, true, &moved_default);
-  EXPECT_LT(error_default, 0.03);
+  const Run default_sigmas = run(with_prior, 1);
+  EXPECT_EQ(default_sigmas.registered, steps);
+  EXPECT_LT(default_sigmas.worst_error_m, 0.03);
   ScanOdometryConfig certain = with_prior;
   certain.prior_sigma_base_m = 1e-5;
   certain.prior_sigma_per_m = 0.0;
   certain.prior_sigma_base_rad = 1e-6;
   certain.prior_sigma_per_rad = 0.0;
   certain.prior_sigma_rad_per_m = 0.0;
-  double moved_certain = 0.0;
-  const double error_certain = worst_error_m(certain, true, &moved_certain);
-  EXPECT_LT(moved_certain, 1e-3);  // every pose at the prediction
-  EXPECT_GT(error_certain, 0.1);   // so the odometry's drift stays
-  EXPECT_GT(moved_default, 10.0 * moved_certain);
-  double moved_without_odometry = 0.0;
-  EXPECT_LT(worst_error_m(certain, false, &moved_without_odometry), 0.03);
+  const Run held = run(certain, 1);
+  EXPECT_EQ(held.registered, steps);              // ICP ran and converged on every scan ...
+  EXPECT_LT(held.worst_from_prediction_m, 1e-3);  // ... to the prediction
+  EXPECT_GT(held.worst_error_m, 0.1);             // so the odometry's drift stays
+  EXPECT_GT(default_sigmas.worst_from_prediction_m, 10.0 * held.worst_from_prediction_m);
+  // No odometry, or never on two scans in a row: no increment measured, no prior.
+  EXPECT_LT(run(certain, 0).worst_error_m, 0.03);
+  EXPECT_LT(run(certain, 2).worst_error_m, 0.03);
   certain.odometry_prior = false;
-  EXPECT_LT(worst_error_m(certain, true, &moved_default), 0.03);
+  EXPECT_LT(run(certain, 1).worst_error_m, 0.03);
 }
 
 TEST(ScanOdometryTest, OdometryPriorConfigIsValidated) {
   for (const auto& [field, set] :
        std::vector<std::pair<std::string, void (*)(ScanOdometryConfig&)>>{
            {"prior_point_sigma_m", [](ScanOdometryConfig& c) { c.prior_point_sigma_m = 0.0; }},
+           {"prior_point_sigma_m", [](ScanOdometryConfig& c) { c.prior_point_sigma_m = 1e200; }},
+           {"prior_sigma_base_m", [](ScanOdometryConfig& c) { c.prior_sigma_base_m = 1e-160; }},
            {"prior_sigma_base_m", [](ScanOdometryConfig& c) { c.prior_sigma_base_m = -1.0; }},
            {"prior_sigma_per_m", [](ScanOdometryConfig& c) { c.prior_sigma_per_m = NAN; }},
            {"prior_sigma_base_rad", [](ScanOdometryConfig& c) { c.prior_sigma_base_rad = 0.0; }},

@@ -129,8 +129,10 @@ struct PlaceMatch {
   double second_score = 0.0;  // best distinct verified candidate (0 if none)
   // In [0, 1]: min(1, consensus / confidence_consensus) * gamma * (1 - second_score / score).
   double confidence = 0.0;
-  int candidates = 0;           // places with >= mu pairs
-  int candidates_verified = 0;  // candidates that went through RANSAC
+  int candidates = 0;  // places with >= mu pairs
+  // Candidates that went through RANSAC in the sequential order, up to and including the first
+  // verified one for `first_verified` (RANSACs verified ahead in a wave are not counted).
+  int candidates_verified = 0;
   int candidates_accepted = 0;  // candidates that passed both checks
   int places_excluded = 0;      // skipped by the exclusion predicate
   double seconds_pairing = 0.0;
@@ -172,7 +174,10 @@ class PlaceRecognizer {
   /// threads TBB allows (tbb::global_control, the calling task arena) for the pairs of blocks of
   /// places, the candidates' ranking and their verification; every field of the answer but the
   /// seconds_* timings is the same at any number of threads. `exclude` is called on the calling
-  /// thread only.
+  /// thread only, but how often depends on the threads (neighbours of candidates verified ahead
+  /// in a wave), so it must be a pure predicate. With `first_verified` a wave verifies as many
+  /// candidates as there are threads, also when queries already run in parallel, so up to
+  /// threads - 1 RANSACs past the first verified one run and are not counted.
   PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
 
   const std::vector<Place>& places() const { return places_; }

@@ -88,8 +88,10 @@ struct IcpResult {
   int num_inliers = 0;          // inliers at the final pose
   double inlier_ratio = 0.0;    // num_inliers / num_source_points
   double residual_rms_m = 0.0;  // RMS point-to-line distance of the inliers
-  // True when at least one direction was held at the initial guess by the degeneracy guard in
-  // the last iteration (e.g. a corridor); then the pose is only partially measured.
+  // True when the points of the last iteration leave at least one direction below the degeneracy
+  // guard (e.g. a corridor's axis): without a prior that direction was held at the initial
+  // guess, with one the prior decided it. Either way the points alone measure the pose only
+  // partially.
   bool degenerate = false;
   // True when the iterates returned to a recent pose (a cycle of the nearest-neighbour
   // association) and the estimate is the mean of the cycle; counts as converged.
@@ -152,6 +154,8 @@ struct IcpPosePrior {
 
 /// Aligns `source` (points in the source frame) to `target`, starting from T_target_source_guess.
 /// Expected failures are reported in the result; the config is validated (std::invalid_argument).
+/// With fewer than 3 correspondences the result is kSingular, prior or not. The information
+/// must be positive definite: a prior on some axes only is a large sigma on the others.
 /// With a prior the normal equations include it and no direction is held by the degeneracy guard
 /// (the prior is what keeps a weakly measured direction near its mean); `degenerate` still reports
 /// whether the points alone would have been held.

@@ -103,7 +103,7 @@ struct ScanOdometryResult {
   ScanOdometryStatus status = ScanOdometryStatus::kFirstScan;
   bool converged = false;   // true for kRegistered, kRecovered and kFirstScan
   bool fell_back = false;   // true for every kFallback* status
-  bool degenerate = false;  // ICP held a weak direction at the odometry guess
+  bool degenerate = false;  // ICP's points left a direction unmeasured (IcpResult::degenerate)
   bool keyframe = false;    // the scan was added to the local map
   IcpStatus icp_status = IcpStatus::kTooFewPoints;
   int iterations = 0;
@@ -144,6 +144,8 @@ class ScanOdometry {
   ScanOdometryConfig config_;
   std::size_t num_scans_ = 0;
   bool have_previous_odometry_ = false;
+  // The previous scan had odometry: only then is the increment one step's measurement.
+  bool previous_scan_had_odometry_ = false;
   Pose2 previous_odometry_laser_;  // T_odom_laser of the previous scan
   Pose2 previous_T_world_laser_;
   Pose2 last_keyframe_T_world_laser_;
