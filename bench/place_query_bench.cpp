@@ -16,6 +16,7 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
+#include "bundled_fr079_queries.hpp"
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/localization.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
@@ -25,28 +26,8 @@ namespace {
 
 using keyplace::PlaceRecognitionConfig;
 
-struct Bundled {
-  std::vector<keyplace::Place> places;
-  std::vector<keyplace::LocalizationQuery> queries;
-};
-
-const Bundled& Load() {
-  static const Bundled bundled = [] {
-    const keyplace::LogInputs inputs = keyplace::PrepareLogInputs(std::string(KEYPLACE_SOURCE_DIR) +
-                                                                  "/data/fr079-corrected.log.gz");
-    const keyplace::GlobalMap map = keyplace::BuildGlobalMap(
-        {inputs.log.scans, inputs.poses, inputs.keypoints}, keyplace::MappingConfig{});
-    const keyplace::GroundTruth truth = keyplace::TruthFromOwnPoses(inputs.log);
-    const std::vector<keyplace::LocalizationQuery> all =
-        keyplace::BuildSubmapQueries(inputs, truth, map.config, keyplace::QueryStarts(truth, 500),
-                                     PlaceRecognitionConfig{}.query_keypoints);
-    Bundled b;
-    b.places = keyplace::PlacesFromMap(map);
-    for (std::size_t i = 0; i < all.size(); i += 5) b.queries.push_back(all[i]);
-    return b;
-  }();
-  return bundled;
-}
+using Bundled = keyplace_bench::BundledFr079;
+const Bundled& Load() { return keyplace_bench::LoadBundledFr079(); }
 
 void BM_Query(benchmark::State& state, const std::string& preset) {
   const Bundled& b = Load();
