@@ -24,9 +24,9 @@ inline const BundledFr079& LoadBundledFr079() {
     const keyplace::GlobalMap map = keyplace::BuildGlobalMap(
         {inputs.log.scans, inputs.poses, inputs.keypoints}, keyplace::MappingConfig{});
     const keyplace::GroundTruth truth = keyplace::TruthFromOwnPoses(inputs.log);
-    const std::vector<keyplace::LocalizationQuery> all = keyplace::BuildSubmapQueries(
-        inputs, truth, map.config, keyplace::QueryStarts(truth, 500),
-        keyplace::PlaceRecognitionConfig{}.query_keypoints);
+    const std::vector<keyplace::LocalizationQuery> all =
+        keyplace::BuildSubmapQueries(inputs, truth, map.config, keyplace::QueryStarts(truth, 500),
+                                     keyplace::PlaceRecognitionConfig{}.query_keypoints);
     BundledFr079 b;
     b.places = keyplace::PlacesFromMap(map);
     for (std::size_t i = 0; i < all.size(); i += 5) b.queries.push_back(all[i]);
