@@ -474,6 +474,52 @@ std::size_t AvailableThreads() {
   return std::max<std::size_t>(1, std::min(arena, allowed));
 }
 
+// Geometric verification of the first `to_verify` candidates, in parallel, each into its own
+// slot, gathered in candidate order into match.verified_candidates and
+// match.candidates_verified. kFirstVerified verifies them in waves of as many as there are
+// threads (one at a time on one thread) and stops after the wave holding the first verified
+// one; within a wave, candidates after a verified one are skipped. The answer, and
+// candidates_verified (those up to the first verified), are the sequential loop's. `exclude` is
+// called on this thread only.
+void VerifyCandidates(const Verification& v, const std::vector<Candidate>& candidates,
+                      std::size_t to_verify, const PlaceExclusion& exclude, PlaceMatch& match) {
+  const bool first_verified =
+      v.config.selection == PlaceRecognitionConfig::Selection::kFirstVerified;
+  const std::size_t wave =
+      first_verified ? AvailableThreads() : std::max<std::size_t>(to_verify, 1);
+  bool done = false;
+  for (std::size_t begin = 0; begin < to_verify && !done; begin += wave) {
+    const std::size_t end = std::min(to_verify, begin + wave);
+    std::vector<std::vector<int>> neighbours(end - begin);
+    if (v.config.verification_neighbours > 0) {
+      for (std::size_t k = begin; k < end; ++k) {
+        neighbours[k - begin] = VerificationNeighbours(v.places, candidates[k].place_index,
+                                                       v.config.verification_neighbours, exclude);
+      }
+    }
+    std::vector<std::optional<CandidateResult>> results(end - begin);
+    std::atomic<std::size_t> first_verified_in_wave{end};
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(begin, end, 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            if (first_verified && k > first_verified_in_wave.load()) return;
+            results[k - begin] = VerifyCandidate(v, candidates[k], neighbours[k - begin]);
+            if (!first_verified || !results[k - begin]) continue;
+            std::size_t seen = first_verified_in_wave.load();
+            while (k < seen && !first_verified_in_wave.compare_exchange_weak(seen, k)) {
+            }
+          }
+        });
+    for (std::size_t k = begin; k < end && !done; ++k) {
+      ++match.candidates_verified;
+      if (!results[k - begin]) continue;
+      match.verified_candidates.push_back(std::move(*results[k - begin]));
+      done = first_verified;
+    }
+  }
+}
+
 }  // namespace
 
 PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
@@ -581,51 +627,13 @@ PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
   }
   match.seconds_pairing = SecondsSince(start);
 
-  // Geometric verification of the first n_c candidates, in parallel, each into its own slot,
-  // gathered in candidate order. kFirstVerified verifies them in waves of as many as there are
-  // threads (one at a time on one thread) and stops after the wave holding the first verified
-  // one; within a wave, candidates after a verified one are skipped. The answer, and
-  // candidates_verified (those up to the first verified), are the sequential loop's.
+  // Geometric verification of the first n_c candidates (VerifyCandidates: in parallel, the
+  // sequential loop's answer).
   const auto verify_start = Clock::now();
   const std::size_t to_verify = std::min(candidates.size(), max_candidates);
-  const bool first_verified =
-      config_.selection == PlaceRecognitionConfig::Selection::kFirstVerified;
-  const std::size_t wave =
-      first_verified ? AvailableThreads() : std::max<std::size_t>(to_verify, 1);
   const Verification verification{places_,          config_,   query,
                                   *match_positions, min_gamma, min_coverage};
-  bool done = false;
-  for (std::size_t begin = 0; begin < to_verify && !done; begin += wave) {
-    const std::size_t end = std::min(to_verify, begin + wave);
-    std::vector<std::vector<int>> neighbours(end - begin);
-    if (config_.verification_neighbours > 0) {
-      for (std::size_t k = begin; k < end; ++k) {
-        neighbours[k - begin] = VerificationNeighbours(places_, candidates[k].place_index,
-                                                       config_.verification_neighbours, exclude);
-      }
-    }
-    std::vector<std::optional<CandidateResult>> results(end - begin);
-    std::atomic<std::size_t> first_verified_in_wave{end};
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(begin, end, 1),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t k = range.begin(); k != range.end(); ++k) {
-            if (first_verified && k > first_verified_in_wave.load()) return;
-            results[k - begin] =
-                VerifyCandidate(verification, candidates[k], neighbours[k - begin]);
-            if (!first_verified || !results[k - begin]) continue;
-            std::size_t seen = first_verified_in_wave.load();
-            while (k < seen && !first_verified_in_wave.compare_exchange_weak(seen, k)) {
-            }
-          }
-        });
-    for (std::size_t k = begin; k < end && !done; ++k) {
-      ++match.candidates_verified;
-      if (!results[k - begin]) continue;
-      match.verified_candidates.push_back(std::move(*results[k - begin]));
-      done = first_verified;
-    }
-  }
+  VerifyCandidates(verification, candidates, to_verify, exclude, match);
   match.candidates_accepted = static_cast<int>(match.verified_candidates.size());
   match.seconds_verification = SecondsSince(verify_start);
 
