@@ -244,11 +244,12 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
           SubsampleBySpacing(points, config_.source_min_spacing_m);
       // Without a measured increment (no odometry now or at the previous scan) the prediction is
       // a guess, not a measurement to be held to.
-      const bool with_prior = config_.odometry_prior && increment_measured;
-      const IcpPosePrior prior =
-          OdometryPrior(predicted_T_world_laser, odometry_increment, config_);
+      std::optional<IcpPosePrior> prior;
+      if (config_.odometry_prior && increment_measured) {
+        prior = OdometryPrior(predicted_T_world_laser, odometry_increment, config_);
+      }
       const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp,
-                                             with_prior ? &prior : nullptr);
+                                             prior ? &*prior : nullptr);
       RecordIcp(icp, &result);
       if (!icp.converged) {
         result.status = icp.status == IcpStatus::kTooFewPoints
