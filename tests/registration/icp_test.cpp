@@ -45,6 +45,18 @@ Pair MakePair(const std::vector<testing::Segment>& world, const Pose2& T_world_t
   return pair;
 }
 
+// Two noisy scans 0.5 m apart along a straight corridor whose ends are out of range: nothing
+// measures the motion along its axis.
+const Pose2 kCorridorTarget(0.0, 0.1, 0.02);
+const Pose2 kCorridorSource(0.5, -0.05, 0.06);
+Pair CorridorPair() {
+  std::mt19937 rng(3);
+  ScanOptions options;
+  options.max_range_m = 10.0;
+  options.range_noise_m = 0.01;
+  return MakePair(testing::Corridor(1.0), kCorridorTarget, kCorridorSource, options, &rng);
+}
+
 TEST(IcpTest, RecoversKnownTransformInPolygonalRoom) {
   const auto world = testing::IrregularRoom();
   for (const int beams : {180, 360}) {
@@ -124,14 +136,9 @@ TEST(IcpTest, RobustKernelBeatsPlainLeastSquaresWithOutliers) {
 }
 
 TEST(IcpTest, DegenerateCorridorStaysAtGuessAlongTheAxis) {
-  const auto world = testing::Corridor(1.0);
-  std::mt19937 rng(3);
-  ScanOptions options;
-  options.max_range_m = 10.0;  // the corridor ends are out of range
-  options.range_noise_m = 0.01;
-  const Pose2 T_world_target(0.0, 0.1, 0.02);
-  const Pose2 T_world_source(0.5, -0.05, 0.06);  // true motion: 0.5 m along the corridor
-  const Pair pair = MakePair(world, T_world_target, T_world_source, options, &rng);
+  const Pose2 T_world_target = kCorridorTarget;
+  const Pose2 T_world_source = kCorridorSource;
+  const Pair pair = CorridorPair();
   const IcpConfig config;
   const IcpTarget target(pair.target, config);
   // Odometry believes in 0.35 m along the axis, and is off laterally / in heading.
@@ -158,14 +165,9 @@ IcpPosePrior PriorAt(const Pose2& mean, double sigma_m, double sigma_rad, double
 }
 
 TEST(IcpTest, PriorDecidesTheCorridorAxisAndThePointsTheRest) {
-  const auto world = testing::Corridor(1.0);
-  std::mt19937 rng(3);
-  ScanOptions options;
-  options.max_range_m = 10.0;  // the corridor ends are out of range
-  options.range_noise_m = 0.01;
-  const Pose2 T_world_target(0.0, 0.1, 0.02);
-  const Pose2 T_world_source(0.5, -0.05, 0.06);
-  const Pair pair = MakePair(world, T_world_target, T_world_source, options, &rng);
+  const Pose2 T_world_target = kCorridorTarget;
+  const Pose2 T_world_source = kCorridorSource;
+  const Pair pair = CorridorPair();
   const IcpConfig config;
   const IcpTarget target(pair.target, config);
   // The guess is 0.2 m short along the axis and off across it; the prior's mean is 0.45 m along.
