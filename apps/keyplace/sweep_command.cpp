@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -136,10 +137,15 @@ void RunSweepMapping(const SweepOptions& options) {
              options.log_path, inputs.log.scans.size(), ToString(inputs.pose_source), grid.size(),
              grid.size() - pending.size(),
              inputs.seconds_read + inputs.seconds_poses + inputs.seconds_keypoints);
-  const std::size_t computed = RunSweepPoints(
-      pending, results, parameters, values, options.stop_after,
-      [&](const std::vector<double>& point) {
-        return MappingSweepRow(inputs, MappingConfigAt(config.mapping, point[0], point[1]));
+  const std::size_t computed = RunSweepGroups(
+      GroupPoints(pending, {0, 1}), results, parameters, values, options.stop_after,
+      [&](const std::vector<std::vector<double>>& points, const std::function<void(double)>&) {
+        std::vector<std::vector<double>> rows;
+        for (const auto& point : points) {
+          rows.push_back(
+              MappingSweepRow(inputs, MappingConfigAt(config.mapping, point[0], point[1])));
+        }
+        return rows;
       });
   PrintSweepSummary(results, grid.size(), computed, options.out_dir);
   WriteSweepJson(options.json_path, results, grid.size(), computed, options.out_dir,
@@ -186,12 +192,20 @@ void RunSweepPlace(const SweepOptions& options) {
       inputs, pending,
       [&](double s_min, double l_g) { return MappingConfigAt(config.mapping, s_min, l_g); },
       options.n_pos, config.place.query_keypoints);
-  const std::size_t computed =
-      RunSweepPoints(pending, results, parameters, values, options.stop_after,
-                     [&](const std::vector<double>& point) {
-                       return PlaceSweepRow(prepared.at({point[0], point[1]}),
-                                            PlaceConfigAt(config.place, point), rule, rank_by);
-                     });
+  // The points of one mapping setting and lambda share their recognitions (PlaceSweepRows).
+  const std::size_t computed = RunSweepGroups(
+      GroupPoints(pending, {0, 1, 4}), results, parameters, values, options.stop_after,
+      [&](const std::vector<std::vector<double>>& points,
+          const std::function<void(double)>& fraction_done) {
+        std::vector<RecognitionThresholds> thresholds;
+        for (const auto& point : points) {
+          const PlaceRecognitionConfig at = PlaceConfigAt(config.place, point);
+          thresholds.push_back({at.min_pairs, at.min_gamma, at.min_gamma_all_scans});
+        }
+        return PlaceSweepRows(prepared.at({points[0][0], points[0][1]}),
+                              PlaceConfigAt(config.place, points[0]), thresholds, rule, rank_by,
+                              fraction_done);
+      });
   PrintSweepSummary(results, grid.size(), computed, options.out_dir);
   WriteSweepJson(options.json_path, results, grid.size(), computed, options.out_dir,
                  SecondsSince(start));
@@ -216,7 +230,8 @@ void AddCommonOptions(CLI::App* command, SweepOptions& options) {
       ->capture_default_str();
   command
       ->add_option("--stop-after", options.stop_after,
-                   "Test hook: start no new grid point once N have started in this run")
+                   "Test hook: start no new group of grid points once N points have started "
+                   "in this run")
       ->group("");
 }
 

@@ -39,21 +39,23 @@ PlaceSweepSetting PreparePlaceSweepSetting(const LogInputs& inputs, const Mappin
   return prepared;
 }
 
-std::vector<double> PlaceSweepRow(const PlaceSweepSetting& data,
-                                  const PlaceRecognitionConfig& place, SelfMatchRule rule,
-                                  RankBy rank_by) {
+std::vector<std::vector<double>> PlaceSweepRows(
+    const PlaceSweepSetting& data, const PlaceRecognitionConfig& place,
+    const std::vector<RecognitionThresholds>& thresholds, SelfMatchRule rule, RankBy rank_by,
+    const std::function<void(double)>& fraction_done) {
   const PlaceRecognizer recognizer(data.places, place);
-  const LocalizationSummary s = Summarize(EvaluateQueries(data.queries, recognizer, rule), rank_by);
-  return {static_cast<double>(s.n_pos),
-          static_cast<double>(s.n_acc),
-          static_cast<double>(s.n_cor),
-          s.precision,
-          s.recall,
-          s.scans_mean,
-          s.p_gl,
-          s.p_cl,
-          static_cast<double>(data.submaps),
-          s.seconds_per_query_mean};
+  const std::vector<std::vector<LocalizationRecord>> records = EvaluateQueriesAtThresholds(
+      data.queries, recognizer, rule, thresholds, [&](std::size_t done, std::size_t total) {
+        fraction_done(static_cast<double>(done) / static_cast<double>(total));
+      });
+  std::vector<std::vector<double>> rows;
+  for (const std::vector<LocalizationRecord>& setting_records : records) {
+    const LocalizationSummary s = Summarize(setting_records, rank_by);
+    rows.push_back({static_cast<double>(s.n_pos), static_cast<double>(s.n_acc),
+                    static_cast<double>(s.n_cor), s.precision, s.recall, s.scans_mean, s.p_gl,
+                    s.p_cl, static_cast<double>(data.submaps), s.seconds_per_query_mean});
+  }
+  return rows;
 }
 
 std::map<std::vector<double>, PlaceSweepSetting> PreparePlaceSweepSettings(

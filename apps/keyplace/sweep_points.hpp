@@ -37,9 +37,13 @@ std::map<std::vector<double>, PlaceSweepSetting> PreparePlaceSweepSettings(
     const std::function<MappingConfig(double, double)>& mapping_at, int n_pos,
     PlaceRecognitionConfig::QueryKeypoints query_keypoints);
 
-/// n_pos, n_acc, n_cor, precision, recall, scans_mean, p_gl, p_cl, submaps, seconds_per_query.
-std::vector<double> PlaceSweepRow(const PlaceSweepSetting& setting,
-                                  const PlaceRecognitionConfig& place, SelfMatchRule rule,
-                                  RankBy rank_by);
+/// One row per threshold setting (n_pos, n_acc, n_cor, precision, recall, scans_mean, p_gl,
+/// p_cl, submaps, seconds_per_query) of `place` with those thresholds: each query is recognised
+/// once for all of them (EvaluateQueriesAtThresholds), so seconds_per_query is the shared
+/// recognition's, the same in every row. `fraction_done` gets the share of the queries done.
+std::vector<std::vector<double>> PlaceSweepRows(
+    const PlaceSweepSetting& setting, const PlaceRecognitionConfig& place,
+    const std::vector<RecognitionThresholds>& thresholds, SelfMatchRule rule, RankBy rank_by,
+    const std::function<void(double)>& fraction_done);
 
 }  // namespace keyplace::cli

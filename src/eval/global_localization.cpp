@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -38,22 +39,25 @@ void SetTruth(const SubmapQueryBuilder& builder, const GroundTruth& truth, Local
   query.truth = truth.Pose(static_cast<std::size_t>(query.evaluated_scan));
 }
 
-// One query of EvaluateQueries.
-LocalizationRecord Evaluate(const LocalizationQuery& query, const PlaceRecognizer& recognizer,
-                            SelfMatchRule rule) {
+// A record of `query` with its answer.
+LocalizationRecord Record(const LocalizationQuery& query, PlaceMatch match) {
   LocalizationRecord record;
   record.start_scan = query.start_scan;
   record.evaluated_scan = query.evaluated_scan;
   record.scans = query.scans;
   record.truth = query.truth;
   record.build_seconds = query.build_seconds;
-  record.match = recognizer.Recognize(query.query, [&](const Place& place) {
-    return IsSelfMatch(rule, query.truth_scans, place.scan_indices);
-  });
+  record.match = std::move(match);
   record.verified_correct =
       record.match.verified && IsCorrectPose(record.match.estimated_pose, record.truth);
   record.correct = record.match.found && record.verified_correct;
   return record;
+}
+
+PlaceExclusion SelfMatches(const LocalizationQuery& query, SelfMatchRule rule) {
+  return [&query, rule](const Place& place) {
+    return IsSelfMatch(rule, query.truth_scans, place.scan_indices);
+  };
 }
 
 }  // namespace
@@ -180,7 +184,31 @@ std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQu
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        records[i] = Evaluate(queries[i], recognizer, rule);
+                        const LocalizationQuery& query = queries[i];
+                        records[i] = Record(
+                            query, recognizer.Recognize(query.query, SelfMatches(query, rule)));
+                        done.ItemDone();
+                      }
+                    });
+  return records;
+}
+
+std::vector<std::vector<LocalizationRecord>> EvaluateQueriesAtThresholds(
+    const std::vector<LocalizationQuery>& queries, const PlaceRecognizer& recognizer,
+    SelfMatchRule rule, const std::vector<RecognitionThresholds>& thresholds,
+    const QueryProgress& progress) {
+  std::vector<std::vector<LocalizationRecord>> records(
+      thresholds.size(), std::vector<LocalizationRecord>(queries.size()));
+  ParallelProgress done(progress, queries.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size()),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const LocalizationQuery& query = queries[i];
+                        std::vector<PlaceMatch> matches = recognizer.RecognizeAtThresholds(
+                            query.query, thresholds, SelfMatches(query, rule));
+                        for (std::size_t k = 0; k < thresholds.size(); ++k) {
+                          records[k][i] = Record(query, std::move(matches[k]));
+                        }
                         done.ItemDone();
                       }
                     });

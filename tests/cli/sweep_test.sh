@@ -3,7 +3,9 @@
 # without redoing finished points and ends with the same table as an uninterrupted run on another
 # thread count; each interruption is checked to have come before the sweep finished (some rows
 # written, not all), else the resume would test nothing; a different sweep in the same directory
-# is refused; bad value lists give clear errors. Usage: sweep_test.sh KEYPLACE_BINARY SOURCE_DIR
+# is refused; bad value lists give clear errors. The place sweep evaluates the points of one
+# lambda together (one recognition per query for every mu and gamma_min), so its rows come in
+# groups. Usage: sweep_test.sh KEYPLACE_BINARY SOURCE_DIR
 set -uo pipefail
 keyplace=$1
 source_dir=$2
@@ -18,6 +20,7 @@ rows() { echo $(($(wc -l <"$1") - 1)); }
 
 place_args=(sweep place --map-log "$log" --scans 0:300 --n-pos 40 --mu 5,10 --gamma-min 0:0.8:0.2
   --lambda 0.05,0.1)
+place_group=10  # points per lambda: 2 mu x 5 gamma_min
 mapping_args=(sweep mapping --log "$log" --scans 0:300 --s-min 0.1:0.5:0.1 --lg 0.05,0.1,0.15)
 
 for kind in place mapping; do
@@ -28,12 +31,14 @@ for kind in place mapping; do
     cat "$work/out"
   fi
   total=$(rows "$work/$kind-ref/results.csv")
-  # Stopped after 4 points, then resumed on 2 threads.
+  # Stopped after 4 points, then resumed on 2 threads. Exactly the points started finish (no
+  # kill): 4 of the mapping sweep, the first group (one lambda) of the place sweep; the grid must
+  # be larger than that.
   "$keyplace" "${args[@]}" --threads 2 --stop-after 4 --out "$work/$kind-cut" >"$work/out1" 2>&1
   first=$(rows "$work/$kind-cut/results.csv")
-  # Exactly the 4 started points finish (no kill), and the grid must be larger than that.
-  if [ "$first" -eq 4 ] && [ "$first" -lt "$total" ]; then ok; else
-    fail "$kind: --stop-after 4 left $first of $total rows"
+  if [ "$kind" = place ]; then started=$place_group; else started=4; fi
+  if [ "$first" -eq "$started" ] && [ "$first" -lt "$total" ]; then ok; else
+    fail "$kind: --stop-after 4 left $first of $total rows, expected $started"
   fi
   "$keyplace" "${args[@]}" --threads 2 --out "$work/$kind-cut" --json "$work/$kind.json" \
     >"$work/out2" 2>&1
@@ -75,12 +80,15 @@ assert j["out"] == sys.argv[5] and j["seconds_total"] > 0, j
 EOF
 done
 
-# A real interruption: kill -9 half-way through the place sweep, then resume. The kill must hit
-# the sweep while it runs (kill succeeds, the exit status is SIGKILL's) and leave rows missing.
-"$keyplace" "${place_args[@]}" --threads 1 --out "$work/killed" >/dev/null 2>&1 &
+# A real interruption: kill -9 half-way through a place sweep, then resume. Its three groups (one
+# per lambda) of the whole log take seconds each on one thread; the kill must hit the sweep while
+# it runs (kill succeeds, the exit status is SIGKILL's) and leave rows missing.
+kill_args=(sweep place --map-log "$log" --n-pos 60 --mu 5,10 --gamma-min 0:0.8:0.4
+  --lambda 0.05,0.1,0.15)
+"$keyplace" "${kill_args[@]}" --threads 1 --out "$work/killed" >/dev/null 2>&1 &
 pid=$!
-total=$(rows "$work/place-ref/results.csv")
-for _ in $(seq 1 2400); do  # up to 2 minutes on a loaded machine; half-way takes ~15 s alone
+total=18
+for _ in $(seq 1 2400); do  # up to 2 minutes on a loaded machine; half-way takes ~10 s alone
   [ -f "$work/killed/results.csv" ] && [ "$(rows "$work/killed/results.csv")" -ge $((total / 2)) ] && break
   kill -0 "$pid" 2>/dev/null || break
   sleep 0.05
@@ -96,7 +104,7 @@ fi
 if [ "$before" -ge 1 ] && [ "$before" -lt "$total" ]; then ok; else
   fail "kill -9 left $before of $total rows: it must come after the first row, before the last"
 fi
-if "$keyplace" "${place_args[@]}" --threads 2 --out "$work/killed" >"$work/out" 2>&1; then ok; else
+if "$keyplace" "${kill_args[@]}" --threads 2 --out "$work/killed" >"$work/out" 2>&1; then ok; else
   fail "resume after kill -9"
   cat "$work/out"
 fi
@@ -108,9 +116,10 @@ then ok; else
   fail "resume after kill -9 at $before of $total rows: not just the $((total - before)) missing"
   grep -v '^\[' "$work/out"
 fi
-if diff <(table "$work/place-ref/results.csv") <(table "$work/killed/results.csv") >/dev/null; then
+"$keyplace" "${kill_args[@]}" --threads 2 --out "$work/unkilled" >/dev/null 2>&1
+if diff <(table "$work/unkilled/results.csv") <(table "$work/killed/results.csv") >/dev/null; then
   ok
-else fail "table after kill -9 at $before of $total rows differs"; fi
+else fail "table after kill -9 at $before of $total rows differs from an uninterrupted run"; fi
 
 # Another sweep in the same directory is refused, naming what differs.
 if "$keyplace" sweep place --map-log "$log" --scans 0:200 --n-pos 40 --out "$work/place-ref" \

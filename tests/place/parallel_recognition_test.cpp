@@ -16,6 +16,7 @@
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 #include "support/bundled_map.hpp"
+#include "support/same_match.hpp"
 
 namespace keyplace {
 namespace {
@@ -37,55 +38,6 @@ std::vector<PlaceMatch> AnswersOnThreads(const PlaceRecognizer& recognizer,
     }
   });
   return answers;
-}
-
-void ExpectSamePose(const Pose2& a, const Pose2& b, const std::string& where) {
-  EXPECT_EQ(a.x, b.x) << where;
-  EXPECT_EQ(a.y, b.y) << where;
-  EXPECT_EQ(a.theta, b.theta) << where;
-}
-
-void ExpectSameCandidate(const CandidateResult& a, const CandidateResult& b,
-                         const std::string& where) {
-  EXPECT_EQ(a.place_index, b.place_index) << where;
-  EXPECT_EQ(a.pairs, b.pairs) << where;
-  EXPECT_EQ(a.mean_pair_distance, b.mean_pair_distance) << where;
-  EXPECT_EQ(a.consensus, b.consensus) << where;
-  EXPECT_EQ(a.gamma, b.gamma) << where;
-  EXPECT_EQ(a.reference_coverage, b.reference_coverage) << where;
-  EXPECT_EQ(a.verified, b.verified) << where;
-  ExpectSamePose(a.T_ref_cur, b.T_ref_cur, where);
-  ExpectSamePose(a.estimated_pose, b.estimated_pose, where);
-  EXPECT_EQ(a.estimated_pose_covariance, b.estimated_pose_covariance) << where;
-  EXPECT_EQ(a.score, b.score) << where;
-}
-
-// Every field but seconds_*.
-void ExpectSameMatch(const PlaceMatch& a, const PlaceMatch& b, const std::string& where) {
-  EXPECT_EQ(a.verified, b.verified) << where;
-  EXPECT_EQ(a.found, b.found) << where;
-  EXPECT_EQ(a.ambiguous, b.ambiguous) << where;
-  EXPECT_EQ(a.place_index, b.place_index) << where;
-  EXPECT_EQ(a.place_id, b.place_id) << where;
-  ExpectSamePose(a.T_ref_cur, b.T_ref_cur, where);
-  ExpectSamePose(a.estimated_pose, b.estimated_pose, where);
-  EXPECT_EQ(a.estimated_pose_covariance, b.estimated_pose_covariance) << where;
-  EXPECT_EQ(a.pairs, b.pairs) << where;
-  EXPECT_EQ(a.consensus, b.consensus) << where;
-  EXPECT_EQ(a.gamma, b.gamma) << where;
-  EXPECT_EQ(a.reference_coverage, b.reference_coverage) << where;
-  EXPECT_EQ(a.score, b.score) << where;
-  EXPECT_EQ(a.second_score, b.second_score) << where;
-  EXPECT_EQ(a.confidence, b.confidence) << where;
-  EXPECT_EQ(a.candidates, b.candidates) << where;
-  EXPECT_EQ(a.candidates_verified, b.candidates_verified) << where;
-  EXPECT_EQ(a.candidates_accepted, b.candidates_accepted) << where;
-  EXPECT_EQ(a.places_excluded, b.places_excluded) << where;
-  ASSERT_EQ(a.verified_candidates.size(), b.verified_candidates.size()) << where;
-  for (std::size_t k = 0; k < a.verified_candidates.size(); ++k) {
-    ExpectSameCandidate(a.verified_candidates[k], b.verified_candidates[k],
-                        where + ", verified candidate " + std::to_string(k));
-  }
 }
 
 // Every 10th of the 500 queries of `keyplace localize` on the bundled log (all-scan keypoints).
@@ -158,9 +110,9 @@ TEST(ParallelRecognition, SameAnswerAtOneTwoAndFourThreadsOnTheBundledLog) {
       const std::vector<PlaceMatch> answers = AnswersOnThreads(recognizer, queries, threads);
       ASSERT_EQ(answers.size(), expected.size());
       for (std::size_t i = 0; i < answers.size(); ++i) {
-        ExpectSameMatch(answers[i], expected[i],
-                        setting.name + ", " + std::to_string(threads) + " threads, start " +
-                            std::to_string(queries[i].start_scan));
+        testing::ExpectSameMatch(answers[i], expected[i],
+                                 setting.name + ", " + std::to_string(threads) +
+                                     " threads, start " + std::to_string(queries[i].start_scan));
       }
     }
   }

@@ -130,6 +130,15 @@ std::vector<LocalizationRecord> EvaluateQueries(const std::vector<LocalizationQu
                                                 SelfMatchRule rule,
                                                 const QueryProgress& progress = {});
 
+/// EvaluateQueries under each of `thresholds` at once (PlaceRecognizer::RecognizeAtThresholds:
+/// the pairs found and each candidate verified once per query). records[k][i] equals what
+/// EvaluateQueries gives for queries[i] with a recognizer of thresholds[k], but for the time
+/// fields of PlaceMatch (the shared work's).
+std::vector<std::vector<LocalizationRecord>> EvaluateQueriesAtThresholds(
+    const std::vector<LocalizationQuery>& queries, const PlaceRecognizer& recognizer,
+    SelfMatchRule rule, const std::vector<RecognitionThresholds>& thresholds,
+    const QueryProgress& progress = {});
+
 /// Whether the true pose of `query` has a scan of `map_scans` within
 /// config.revisit_radius_m and config.revisit_angle_deg whose place `rule` does not exclude for
 /// this query (the exclusion EvaluateQueries applies). `map_scans` are places with the world

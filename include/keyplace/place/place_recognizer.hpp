@@ -144,6 +144,14 @@ struct PlaceMatch {
 /// Returns true for places the query must not be matched with (self-matches).
 using PlaceExclusion = std::function<bool(const Place&)>;
 
+/// The thresholds a parameter sweep varies (paper Figure 9): mu and gamma_min, the latter for
+/// stable and for all-scan query keypoints alike (PlaceRecognitionConfig's fields of these names).
+struct RecognitionThresholds {
+  int min_pairs = 10;
+  double min_gamma = 0.4;
+  double min_gamma_all_scans = 0.15;
+};
+
 class SqrtDescriptorIndex;  // place/descriptor_index.hpp (internal)
 
 class PlaceRecognizer {
@@ -179,6 +187,18 @@ class PlaceRecognizer {
   /// candidates as there are threads, also when queries already run in parallel, so up to
   /// threads - 1 RANSACs past the first verified one run and are not counted.
   PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
+
+  /// Recognize under each of `thresholds` (this recognizer's config with min_pairs, min_gamma and
+  /// min_gamma_all_scans replaced), sharing what they have in common: the descriptor pairs are
+  /// found once, for the smallest mu, and each candidate is verified at most once (its gamma is
+  /// then compared with each threshold; a candidate's RANSAC does not depend on the others).
+  /// answers[k] equals the Recognize answer of a recognizer built with thresholds[k] in every
+  /// field but the seconds_* timings, which are those of the shared work. Recognize is this with
+  /// the config's own thresholds. Throws std::invalid_argument for a threshold that Validate
+  /// would refuse, naming it.
+  std::vector<PlaceMatch> RecognizeAtThresholds(
+      const PlaceQuery& query, const std::vector<RecognitionThresholds>& thresholds,
+      const PlaceExclusion& exclude = {}) const;
 
   const std::vector<Place>& places() const { return places_; }
   const PlaceRecognitionConfig& config() const { return config_; }

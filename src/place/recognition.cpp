@@ -1,0 +1,535 @@
+// PlaceRecognizer::Recognize and RecognizeAtThresholds: Algorithm 3 against every place, the
+// ranking of the candidates, their geometric verification and the choice of the answer. The
+// stages run in parallel (TBB), each result into its own slot, gathered in place or candidate
+// order: the same answer at any number of threads.
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "keyplace/place/place_recognizer.hpp"
+#include "keyplace/place/ransac.hpp"
+#include "place/candidate_ranking.hpp"
+#include "place/descriptor_index.hpp"
+#include "place/unique_pairs.hpp"
+
+namespace keyplace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double SelectionScore(PlaceRecognitionConfig::Score score, int consensus, double gamma) {
+  switch (score) {
+    case PlaceRecognitionConfig::Score::kGamma:
+      return gamma;
+    case PlaceRecognitionConfig::Score::kConsensus:
+      return consensus;
+    case PlaceRecognitionConfig::Score::kConsensusGamma:
+      break;
+  }
+  return consensus * gamma;
+}
+
+// Mixes the RANSAC seed with the place id so that each place's hypotheses do not depend on the
+// order in which candidates are verified.
+std::uint64_t PlaceSeed(std::uint64_t seed, int place_id) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(place_id) + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// A place with enough unique pairs (Algorithm 3).
+struct Candidate {
+  int place_index = -1;  // -1: not a candidate
+  double mean_distance = 0.0;
+  std::vector<DescriptorPair> pairs;
+};
+
+// Grain sizes of the parallel loops (TBB): places of the unique pairs per task (microseconds each
+// with an index), candidates of LargestRigidStar per task (O(pairs^2) each). Candidates are
+// verified in parallel (a RANSAC each, grain 1).
+constexpr std::size_t kPlacesPerTask = 16;
+constexpr std::size_t kRankedCandidatesPerTask = 4;
+
+// The query keypoints paired and verified by RANSAC: the stable ones, or those of every scan
+// merged (kAllScans; the gamma check uses the stable ones either way).
+struct MatchKeypoints {
+  std::vector<Eigen::Vector2d> positions;
+  std::vector<BetaGridDescriptor> descriptors;
+  bool all_scans = false;
+};
+
+MatchKeypoints QueryMatchKeypoints(const PlaceQuery& query, const PlaceRecognitionConfig& config) {
+  MatchKeypoints keypoints;
+  if (config.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans &&
+      !query.all_positions.empty()) {
+    keypoints.all_scans = true;
+    for (int k : MergeNearbyKeypoints(query.all_positions, config.query_merge_m)) {
+      keypoints.positions.push_back(query.all_positions[k]);
+      keypoints.descriptors.push_back(query.all_descriptors[k]);
+    }
+    return keypoints;
+  }
+  keypoints.positions = query.positions;
+  keypoints.descriptors = query.descriptors;
+  return keypoints;
+}
+
+// Algorithm 3 against every place of at least `min_pairs` keypoints that `exclude` lets through.
+struct Pairing {
+  std::vector<Candidate> by_place;  // place p's unique pairs (place_index -1: < min_pairs)
+  std::vector<char> excluded;       // places of >= min_pairs keypoints that `exclude` rejected
+};
+
+Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorIndex* index,
+                       const std::vector<std::size_t>& slots, const PlaceRecognitionConfig& config,
+                       const std::vector<BetaGridDescriptor>& query, std::size_t min_pairs,
+                       const PlaceExclusion& exclude) {
+  Pairing pairing;
+  pairing.by_place.resize(places.size());
+  pairing.excluded.assign(places.size(), 0);
+  std::vector<char> searched(places.size(), 0);
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    if (places[p].positions.size() < min_pairs) continue;  // can never reach mu pairs
+    if (exclude && exclude(places[p])) {
+      pairing.excluded[p] = 1;
+      continue;
+    }
+    searched[p] = 1;
+  }
+  // The index finds, per place, the pairs below the threshold that the exhaustive loop of
+  // MatchDescriptorPairs finds, in its order and with its distances.
+  std::vector<std::vector<DescriptorPair>> below;  // by index slot
+  if (index) {
+    std::vector<char> searched_slots(index->places(), 0);
+    for (std::size_t p = 0; p < places.size(); ++p) searched_slots[slots[p]] = searched[p];
+    index->FindPairs(query, config.descriptor_match_chi2, searched_slots, below);
+  }
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, places.size(), kPlacesPerTask),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t p = range.begin(); p != range.end(); ++p) {
+          if (!searched[p]) continue;
+          const Place& place = places[p];
+          std::vector<DescriptorPair> pairs =
+              index ? UniquePairs(std::move(below[slots[p]]), query.size(),
+                                  place.descriptors.size(), config.pair_matching)
+                    : MatchDescriptorPairs(query, place.descriptors, config.descriptor_match_chi2,
+                                           config.pair_matching);
+          if (pairs.size() < min_pairs) continue;
+          double sum = 0.0;
+          for (const DescriptorPair& pair : pairs) sum += pair.distance;
+          pairing.by_place[p] = {static_cast<int>(p), sum / static_cast<double>(pairs.size()),
+                                 std::move(pairs)};
+        }
+      });
+  return pairing;
+}
+
+// LargestRigidStar of each place, computed once when a ranking first needs it (-1: not yet).
+void ComputeRigidStars(const Pairing& pairing, const std::vector<int>& place_indices,
+                       const std::vector<Place>& places,
+                       const std::vector<Eigen::Vector2d>& match_positions, double rigidity_m2,
+                       std::vector<int>& rigid_star) {
+  std::vector<int> missing;
+  for (int p : place_indices) {
+    if (rigid_star[static_cast<std::size_t>(p)] < 0) missing.push_back(p);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), kRankedCandidatesPerTask),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                        const auto p = static_cast<std::size_t>(missing[k]);
+                        rigid_star[p] = LargestRigidStar(pairing.by_place[p].pairs, match_positions,
+                                                         places[p].positions, rigidity_m2);
+                      }
+                    });
+}
+
+// The candidates of one mu in verification order (place indices): the places with >= mu unique
+// pairs by increasing mean pair distance (place order on ties); with more than n_c of them and
+// kRigidPairs, the n_c most rigid in that order. Sets match.candidates and places_excluded.
+std::vector<int> CandidatesInOrder(const Pairing& pairing, const std::vector<Place>& places,
+                                   const PlaceRecognitionConfig& config, std::size_t min_pairs,
+                                   const std::vector<Eigen::Vector2d>& match_positions,
+                                   std::vector<int>& rigid_star, PlaceMatch& match) {
+  std::vector<int> order;
+  if (match_positions.size() < min_pairs) return order;  // nothing searched, nothing excluded
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    if (pairing.excluded[p] && places[p].positions.size() >= min_pairs) ++match.places_excluded;
+    const Candidate& candidate = pairing.by_place[p];
+    if (candidate.place_index >= 0 && candidate.pairs.size() >= min_pairs) {
+      order.push_back(static_cast<int>(p));
+    }
+  }
+  std::stable_sort(order.begin(), order.end(), [&pairing](int a, int b) {
+    return pairing.by_place[static_cast<std::size_t>(a)].mean_distance <
+           pairing.by_place[static_cast<std::size_t>(b)].mean_distance;
+  });
+  match.candidates = static_cast<int>(order.size());
+  const auto max_candidates = static_cast<std::size_t>(config.max_candidates);
+  if (order.size() > max_candidates &&
+      config.candidate_ranking == PlaceRecognitionConfig::CandidateRanking::kRigidPairs) {
+    ComputeRigidStars(pairing, order, places, match_positions, config.ransac.rigidity_m2,
+                      rigid_star);
+    std::vector<int> stars;
+    stars.reserve(order.size());
+    for (int p : order) stars.push_back(rigid_star[static_cast<std::size_t>(p)]);
+    std::vector<int> kept;
+    kept.reserve(max_candidates);
+    for (std::size_t k : KeepMostRigid(stars, max_candidates)) kept.push_back(order[k]);
+    order = std::move(kept);
+  }
+  order.resize(std::min(order.size(), max_candidates));
+  return order;
+}
+
+// What the verification of the candidates of one query reads.
+struct Verification {
+  const std::vector<Place>& places;
+  const PlaceRecognitionConfig& config;
+  const PlaceQuery& query;
+  const Pairing& pairing;
+  const std::vector<Eigen::Vector2d>& match_positions;  // the query keypoints paired
+  double min_gamma;  // the lowest of the thresholds: a candidate below it passes none
+  double min_coverage;
+};
+
+// The map neighbours of places[place_index] (ids adjacent to its own, within
+// verification_neighbours, in offset order) that `exclude` lets through.
+std::vector<int> VerificationNeighbours(const std::vector<Place>& places, int place_index,
+                                        int verification_neighbours,
+                                        const PlaceExclusion& exclude) {
+  std::vector<int> neighbours;
+  const Place& place = places[static_cast<std::size_t>(place_index)];
+  const int count = static_cast<int>(places.size());
+  for (int offset = -verification_neighbours; offset <= verification_neighbours; ++offset) {
+    const int n = place_index + offset;
+    if (offset == 0 || n < 0 || n >= count) continue;
+    const Place& neighbour = places[static_cast<std::size_t>(n)];
+    if (neighbour.id != place.id + offset) continue;  // not adjacent in the map
+    if (exclude && exclude(neighbour)) continue;
+    neighbours.push_back(n);
+  }
+  return neighbours;
+}
+
+// RANSAC and the three checks of one candidate (the place's own seed: the answer does not depend
+// on which other candidates are verified, nor in which order). nullopt: not verified.
+std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Candidate& candidate,
+                                               const std::vector<int>& neighbours) {
+  const PlaceRecognitionConfig& config = v.config;
+  const Place& place = v.places[static_cast<std::size_t>(candidate.place_index)];
+  std::vector<std::pair<int, int>> index_pairs;
+  index_pairs.reserve(candidate.pairs.size());
+  for (const DescriptorPair& pair : candidate.pairs) {
+    index_pairs.emplace_back(pair.current, pair.reference);
+  }
+  RansacConfig ransac = config.ransac;
+  ransac.seed = PlaceSeed(config.ransac.seed, place.id);
+  // The reference: the candidate, then its map neighbours in its frame (pairs index the
+  // candidate's keypoints, which come first).
+  std::vector<Eigen::Vector2d> extended_positions;
+  std::vector<BetaGridDescriptor> extended_descriptors;
+  const std::vector<Eigen::Vector2d>* reference_positions = &place.positions;
+  const std::vector<BetaGridDescriptor>* reference_descriptors = &place.descriptors;
+  if (config.verification_neighbours > 0) {
+    extended_positions = place.positions;
+    extended_descriptors = place.descriptors;
+    const double merge2 = config.ransac.inlier_distance_m * config.ransac.inlier_distance_m;
+    for (int n : neighbours) {
+      const Place& neighbour = v.places[static_cast<std::size_t>(n)];
+      const Pose2 T_place_neighbour = Between(place.T_world_place, neighbour.T_world_place);
+      const std::size_t own = extended_positions.size();
+      for (std::size_t q = 0; q < neighbour.positions.size(); ++q) {
+        const Eigen::Vector2d p = T_place_neighbour * neighbour.positions[q];
+        bool duplicate = false;
+        for (std::size_t j = 0; j < own && !duplicate; ++j) {
+          duplicate = (extended_positions[j] - p).squaredNorm() < merge2;
+        }
+        if (duplicate) continue;
+        extended_positions.push_back(p);
+        extended_descriptors.push_back(neighbour.descriptors[q]);
+      }
+    }
+    reference_positions = &extended_positions;
+    reference_descriptors = &extended_descriptors;
+  }
+  const RansacResult estimate =
+      EstimateRigidTransformRansac(*reference_positions, v.match_positions, index_pairs, ransac);
+  if (!estimate.valid) return std::nullopt;
+  const int consensus = CountConsensus(estimate.inliers, config.consensus_counting);
+  if (consensus < config.min_consensus) return std::nullopt;  // first check
+  const GammaResult gamma =
+      ComputeGamma(*reference_positions, *reference_descriptors, v.query.positions,
+                   v.query.descriptors, estimate.T_ref_cur, config.double_match_m,
+                   config.descriptor_match_chi2, config.gamma_counting);
+  if (gamma.gamma < v.min_gamma) return std::nullopt;  // second check
+  const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
+                                            estimate.T_ref_cur, config.ransac.inlier_distance_m);
+  if (coverage < v.min_coverage) return std::nullopt;  // third check (ours)
+  CandidateResult result;
+  result.place_index = candidate.place_index;
+  result.pairs = static_cast<int>(candidate.pairs.size());
+  result.mean_pair_distance = candidate.mean_distance;
+  result.consensus = consensus;
+  result.gamma = gamma.gamma;
+  result.reference_coverage = coverage;
+  result.verified = true;
+  result.T_ref_cur = estimate.T_ref_cur;
+  result.estimated_pose = place.T_world_place * estimate.T_ref_cur * v.query.T_first_evaluated;
+  result.estimated_pose_covariance = ComposedCovariance(
+      place.T_world_place, estimate.T_ref_cur, v.query.T_first_evaluated,
+      RigidFitCovariance(*reference_positions, v.match_positions, estimate.inliers,
+                         estimate.T_ref_cur, config.ransac.min_fit_sigma_m));
+  result.score = SelectionScore(config.score, consensus, gamma.gamma);
+  return result;
+}
+
+// The threads a parallel loop started here may use (the arena's, within the global control).
+std::size_t AvailableThreads() {
+  const auto arena = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const std::size_t allowed =
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  return std::max<std::size_t>(1, std::min(arena, allowed));
+}
+
+// Each place's verification, done at most once per query: the thresholds share it. Results are
+// kept for the places verified only (a map may have 10^5 places).
+struct VerifiedPlaces {
+  explicit VerifiedPlaces(std::size_t places) : slot(places, -1) {}
+  std::vector<int> slot;  // into results; -1: not verified
+  std::vector<std::optional<CandidateResult>> results;
+  bool Done(int p) const { return slot[static_cast<std::size_t>(p)] >= 0; }
+  const std::optional<CandidateResult>& Result(int p) const {
+    return results[static_cast<std::size_t>(slot[static_cast<std::size_t>(p)])];
+  }
+  bool Passes(int p, double min_gamma) const {
+    return Done(p) && Result(p) && Result(p)->gamma >= min_gamma;
+  }
+};
+
+// Verifies the places of `order` (no place twice) not verified yet, in parallel, each into its
+// own slot. With `first_passing` set, a place after one passing `first_passing_gamma` may be
+// skipped (it stays unverified). Neighbours (`exclude`) are found on this thread.
+void VerifyPlaces(const Verification& v, const std::vector<int>& order, bool first_passing,
+                  double first_passing_gamma, const PlaceExclusion& exclude,
+                  VerifiedPlaces& verified) {
+  std::vector<int> todo;
+  for (int p : order) {
+    if (!verified.Done(p)) todo.push_back(p);
+  }
+  const std::size_t first_slot = verified.results.size();
+  verified.results.resize(first_slot + todo.size());
+  std::vector<std::vector<int>> neighbours(todo.size());
+  if (v.config.verification_neighbours > 0) {
+    for (std::size_t k = 0; k < todo.size(); ++k) {
+      neighbours[k] =
+          VerificationNeighbours(v.places, todo[k], v.config.verification_neighbours, exclude);
+    }
+  }
+  std::vector<char> computed(todo.size(), 0);
+  std::atomic<std::size_t> first_passed{todo.size()};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, todo.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                        if (first_passing && k > first_passed.load()) return;
+                        auto& result = verified.results[first_slot + k];
+                        result = VerifyCandidate(
+                            v, v.pairing.by_place[static_cast<std::size_t>(todo[k])],
+                            neighbours[k]);
+                        computed[k] = 1;
+                        if (!first_passing || !result || result->gamma < first_passing_gamma) {
+                          continue;
+                        }
+                        std::size_t seen = first_passed.load();
+                        while (k < seen && !first_passed.compare_exchange_weak(seen, k)) {
+                        }
+                      }
+                    });
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    if (computed[k])
+      verified.slot[static_cast<std::size_t>(todo[k])] = static_cast<int>(first_slot + k);
+  }
+}
+
+// The verified candidates of one threshold, in candidate order, into match.verified_candidates
+// and match.candidates_verified. kFirstVerified verifies in waves of as many candidates as there
+// are threads (one at a time on one thread) and stops after the wave holding the first verified
+// one: the answer, and candidates_verified (those up to the first verified), are the sequential
+// loop's.
+void GatherVerified(const Verification& v, const std::vector<int>& order, double min_gamma,
+                    const PlaceExclusion& exclude, VerifiedPlaces& verified, PlaceMatch& match) {
+  const bool first_verified =
+      v.config.selection == PlaceRecognitionConfig::Selection::kFirstVerified;
+  const std::size_t wave =
+      first_verified ? AvailableThreads() : std::max<std::size_t>(order.size(), 1);
+  bool done = false;
+  for (std::size_t begin = 0; begin < order.size() && !done; begin += wave) {
+    const std::size_t end = std::min(order.size(), begin + wave);
+    const std::vector<int> slice(order.begin() + static_cast<std::ptrdiff_t>(begin),
+                                 order.begin() + static_cast<std::ptrdiff_t>(end));
+    VerifyPlaces(v, slice, first_verified, min_gamma, exclude, verified);
+    for (std::size_t k = begin; k < end && !done; ++k) {
+      ++match.candidates_verified;
+      if (!verified.Passes(order[k], min_gamma)) continue;
+      match.verified_candidates.push_back(*verified.Result(order[k]));
+      done = first_verified;
+    }
+  }
+}
+
+// The answer among match.verified_candidates: the best score, unless a distinct one comes close.
+void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig& config,
+                  PlaceMatch& match) {
+  match.candidates_accepted = static_cast<int>(match.verified_candidates.size());
+  if (match.verified_candidates.empty()) return;
+  // The best score; ties keep the earlier candidate (smaller mean pair distance).
+  const CandidateResult* best = &match.verified_candidates.front();
+  for (const CandidateResult& candidate : match.verified_candidates) {
+    if (candidate.score > best->score) best = &candidate;
+  }
+  const double distinct_angle = config.distinct_angle_deg * M_PI / 180.0;
+  double second = 0.0;
+  for (const CandidateResult& candidate : match.verified_candidates) {
+    const Pose2 delta = Between(best->estimated_pose, candidate.estimated_pose);
+    const bool distinct = TranslationNorm(delta) > config.distinct_distance_m ||
+                          std::abs(delta.theta) > distinct_angle;
+    if (distinct) second = std::max(second, candidate.score);
+  }
+  match.verified = true;
+  match.place_index = best->place_index;
+  match.place_id = places[static_cast<std::size_t>(best->place_index)].id;
+  match.T_ref_cur = best->T_ref_cur;
+  match.estimated_pose = best->estimated_pose;
+  match.estimated_pose_covariance = best->estimated_pose_covariance;
+  match.pairs = best->pairs;
+  match.consensus = best->consensus;
+  match.gamma = best->gamma;
+  match.reference_coverage = best->reference_coverage;
+  match.score = best->score;
+  match.second_score = second;
+  const double consensus_factor =
+      std::min(1.0, static_cast<double>(best->consensus) / config.confidence_consensus);
+  const double gap = best->score > 0.0 ? std::max(0.0, 1.0 - second / best->score) : 0.0;
+  match.confidence = consensus_factor * best->gamma * gap;
+  match.ambiguous = second > 0.0 && second >= config.ambiguity_ratio * best->score;
+  match.found = !match.ambiguous && match.confidence >= config.min_confidence;
+}
+
+void CheckThresholds(const std::vector<RecognitionThresholds>& thresholds) {
+  for (std::size_t k = 0; k < thresholds.size(); ++k) {
+    const RecognitionThresholds& t = thresholds[k];
+    const std::string where = "recognition thresholds " + std::to_string(k) + ": ";
+    if (t.min_pairs < 2) throw std::invalid_argument(where + "min_pairs must be >= 2");
+    for (double gamma : {t.min_gamma, t.min_gamma_all_scans}) {
+      if (!(gamma >= 0.0 && gamma <= 1.0)) {
+        throw std::invalid_argument(where + "min_gamma and min_gamma_all_scans must lie in [0, 1]");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
+                                      const PlaceExclusion& exclude) const {
+  const RecognitionThresholds own{config_.min_pairs, config_.min_gamma,
+                                  config_.min_gamma_all_scans};
+  return RecognizeAtThresholds(query, {own}, exclude).front();
+}
+
+std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
+    const PlaceQuery& query, const std::vector<RecognitionThresholds>& thresholds,
+    const PlaceExclusion& exclude) const {
+  const auto start = Clock::now();
+  if (query.positions.size() != query.descriptors.size()) {
+    throw std::invalid_argument("PlaceQuery: positions and descriptors differ in size");
+  }
+  if (query.all_positions.size() != query.all_descriptors.size()) {
+    throw std::invalid_argument("PlaceQuery: all_positions and all_descriptors differ in size");
+  }
+  CheckThresholds(thresholds);
+  std::vector<PlaceMatch> matches(thresholds.size());
+  if (thresholds.empty()) return matches;
+  const MatchKeypoints keypoints = QueryMatchKeypoints(query, config_);
+  const auto gamma_of = [&keypoints](const RecognitionThresholds& t) {
+    return keypoints.all_scans ? t.min_gamma_all_scans : t.min_gamma;
+  };
+  const auto lowest = [&](auto value) {
+    auto low = value(thresholds.front());
+    for (const RecognitionThresholds& t : thresholds) low = std::min(low, value(t));
+    return low;
+  };
+  const auto lowest_pairs =
+      static_cast<std::size_t>(lowest([](const RecognitionThresholds& t) { return t.min_pairs; }));
+
+  // Algorithm 3 once, for the smallest mu; each threshold's candidates are among its places.
+  Pairing pairing;
+  if (keypoints.positions.size() >= lowest_pairs) {
+    pairing = PairWithPlaces(places_, index_.get(), slots_, config_, keypoints.descriptors,
+                             lowest_pairs, exclude);
+  }
+  std::vector<int> rigid_star(places_.size(), -1);
+  std::vector<std::vector<int>> orders(thresholds.size());
+  for (std::size_t k = 0; k < thresholds.size(); ++k) {
+    if (pairing.by_place.empty()) continue;
+    orders[k] = CandidatesInOrder(pairing, places_, config_,
+                                  static_cast<std::size_t>(thresholds[k].min_pairs),
+                                  keypoints.positions, rigid_star, matches[k]);
+  }
+  const double seconds_pairing = SecondsSince(start);
+
+  // Geometric verification, each candidate at most once for all thresholds.
+  const auto verify_start = Clock::now();
+  const double min_coverage = keypoints.all_scans ? config_.min_reference_coverage : 0.0;
+  const Verification verification{
+      places_, config_, query, pairing, keypoints.positions, lowest(gamma_of), min_coverage};
+  VerifiedPlaces verified(places_.size());
+  if (config_.selection != PlaceRecognitionConfig::Selection::kFirstVerified) {
+    // Every threshold's candidates (each place once), verified in one parallel pass.
+    std::vector<char> listed(orders.size() > 1 ? places_.size() : 0, 0);
+    std::vector<int> all = orders.front();
+    for (std::size_t k = 1; k < orders.size(); ++k) {
+      if (k == 1) {
+        for (int p : all) listed[static_cast<std::size_t>(p)] = 1;
+      }
+      for (int p : orders[k]) {
+        if (listed[static_cast<std::size_t>(p)]) continue;
+        listed[static_cast<std::size_t>(p)] = 1;
+        all.push_back(p);
+      }
+    }
+    VerifyPlaces(verification, all, false, 0.0, exclude, verified);
+  }
+  for (std::size_t k = 0; k < thresholds.size(); ++k) {
+    GatherVerified(verification, orders[k], gamma_of(thresholds[k]), exclude, verified, matches[k]);
+    ChooseAnswer(places_, config_, matches[k]);
+  }
+  const double seconds_verification = SecondsSince(verify_start);
+  const double seconds = SecondsSince(start);
+  for (PlaceMatch& match : matches) {
+    match.seconds_pairing = seconds_pairing;
+    match.seconds_verification = seconds_verification;
+    match.seconds = seconds;
+  }
+  return matches;
+}
+
+}  // namespace keyplace
