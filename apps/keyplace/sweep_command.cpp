@@ -141,6 +141,7 @@ void RunSweepMapping(const SweepOptions& options) {
       GroupPoints(pending, {0, 1}), results, parameters, values, options.stop_after,
       [&](const std::vector<std::vector<double>>& points, const std::function<void(double)>&) {
         std::vector<std::vector<double>> rows;
+        rows.reserve(points.size());
         for (const auto& point : points) {
           rows.push_back(
               MappingSweepRow(inputs, MappingConfigAt(config.mapping, point[0], point[1])));

@@ -30,6 +30,7 @@ std::vector<std::vector<std::vector<double>>> GroupPoints(
   std::vector<std::vector<std::vector<double>>> groups;
   for (const auto& point : pending) {
     std::vector<double> key;
+    key.reserve(shared_columns.size());
     for (std::size_t column : shared_columns) key.push_back(point.at(column));
     const auto it = std::find(keys.begin(), keys.end(), key);
     if (it == keys.end()) {
