@@ -101,16 +101,18 @@ std::string Quoted(const std::string& arg) {
   return out + "'";
 }
 
-// What makes a step's result: its command line without --threads, which changes only the time
-// (docs/SWEEPS.md), so that a report resumed with another thread count reuses the sweeps.
+// What makes a step's result: its command line without --threads and --cache, which change only
+// the time (docs/SWEEPS.md; LogInputOptions::cache_dir), so that a report resumed with another
+// thread count reuses the sweeps.
 std::string Identity(const ReportStep& step) {
   ReportStep copy = step;
-  for (std::size_t i = 0; i + 1 < copy.args.size(); ++i) {
-    if (copy.args[i] == "--threads") {
-      copy.args.erase(copy.args.begin() + static_cast<std::ptrdiff_t>(i),
-                      copy.args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
-      break;
+  copy.args.clear();
+  for (std::size_t i = 0; i < step.args.size(); ++i) {
+    if ((step.args[i] == "--threads" || step.args[i] == "--cache") && i + 1 < step.args.size()) {
+      ++i;
+      continue;
     }
+    copy.args.push_back(step.args[i]);
   }
   return CommandLine(copy);
 }
@@ -160,6 +162,9 @@ std::string ReportArtefacts::RelocalizePng(const ReportSettings& s, const std::s
                                            bool raw) {
   return Join(s.work_dir, "relocalize/" + base + (raw ? "-raw" : "") + ".png");
 }
+std::string ReportArtefacts::PreparationCache(const ReportSettings& s) {
+  return Join(s.work_dir, "cache");
+}
 std::string ReportArtefacts::Fig8Dir(const ReportSettings& s, const std::string& base) {
   return Join(s.work_dir, "sweeps/fig8-" + base);
 }
@@ -187,6 +192,7 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
   const std::string n_pos = s.quick ? "20" : "500";
   const std::string starts = s.quick ? "6" : "50";
   const std::string threads = std::to_string(s.threads);
+  const std::string cache = A::PreparationCache(s);
   const std::vector<std::string> presets{"default", "paper"};
   const std::vector<double> lambdas{0.05, 0.1};
   for (const std::string& base : s.datasets) {
@@ -198,19 +204,21 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
     steps.push_back({"map-" + base,
                      "Figure 3-5 map and localization map, " + f.name,
                      {"map", log, "--out", A::Map(s, base), "--json", A::MapJson(s, base), "--png",
-                      A::MapPng(s, base)},
+                      A::MapPng(s, base), "--cache", cache},
                      {log},
                      {A::Map(s, base), A::MapJson(s, base), A::MapPng(s, base)}});
-    steps.push_back({"map-" + base + "-overlap-only",
-                     "Table II, " + f.name,
-                     {"map", log, "--overlap-only", "--json", A::TableIIJson(s, base)},
-                     {log},
-                     {A::TableIIJson(s, base)}});
-    steps.push_back({"map-" + base + "-raw-icp",
-                     "Table VI, " + f.name + "_r",
-                     {"map", raw, "--poses", "icp", "--json", A::RawMapJson(s, base)},
-                     {raw},
-                     {A::RawMapJson(s, base)}});
+    steps.push_back(
+        {"map-" + base + "-overlap-only",
+         "Table II, " + f.name,
+         {"map", log, "--overlap-only", "--json", A::TableIIJson(s, base), "--cache", cache},
+         {log},
+         {A::TableIIJson(s, base)}});
+    steps.push_back(
+        {"map-" + base + "-raw-icp",
+         "Table VI, " + f.name + "_r",
+         {"map", raw, "--poses", "icp", "--json", A::RawMapJson(s, base), "--cache", cache},
+         {raw},
+         {A::RawMapJson(s, base)}});
     // Global localization: Tables III/IV (corrected queries), VII/VIII (raw queries) and X
     // (mu 5 as well, FR079 and Intel only).
     for (const bool raw_queries : {false, true}) {
@@ -232,7 +240,7 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
             }
             args.insert(args.end(), {"--preset", preset, "--lambda", LambdaText(lambda), "--mu",
                                      std::to_string(mu), "--n-pos", n_pos, "--threads", threads,
-                                     "--json", out});
+                                     "--cache", cache, "--json", out});
             const std::string table =
                 mu == 5 ? "Table X"
                         : (raw_queries ? (lambda < 0.07 ? "Table VII" : "Table VIII")
@@ -252,14 +260,14 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
       steps.push_back({"localize-" + base + "-tip-flirt",
                        "Table X, TIP-FLIRT baseline, " + f.name,
                        {"localize", "--baseline", "tip-flirt", "--log", log, "--n-pos", n_pos,
-                        "--threads", threads, "--json", A::TipFlirt(s, base)},
+                        "--threads", threads, "--cache", cache, "--json", A::TipFlirt(s, base)},
                        {log},
                        {A::TipFlirt(s, base)}});
       steps.push_back({"localize-" + base + "-tip-flirt-mu5",
                        "Table X, TIP-FLIRT baseline with mu 5 and consensus 5, " + f.name,
                        {"localize", "--baseline", "tip-flirt", "--log", log, "--mu", "5", "--set",
-                        "place.min_consensus=5", "--n-pos", n_pos, "--threads", threads, "--json",
-                        A::TipFlirt(s, base, 5)},
+                        "place.min_consensus=5", "--n-pos", n_pos, "--threads", threads, "--cache",
+                        cache, "--json", A::TipFlirt(s, base, 5)},
                        {log},
                        {A::TipFlirt(s, base, 5)}});
     }
@@ -278,8 +286,8 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
         args.insert(args.end(), {"--log", log, "--self-match", "shared-scan"});
         needs.push_back(log);
       }
-      args.insert(args.end(),
-                  {"--starts", starts, "--threads", threads, "--json", json, "--figure", png});
+      args.insert(args.end(), {"--starts", starts, "--threads", threads, "--cache", cache, "--json",
+                               json, "--figure", png});
       steps.push_back(
           {"relocalize-" + base + (raw_queries ? "-raw" : ""),
            raw_queries

@@ -44,6 +44,9 @@ struct ReportArtefacts {
   static std::string Relocalize(const ReportSettings& s, const std::string& base, bool raw);
   static std::string RelocalizePng(const ReportSettings& s, const std::string& base, bool raw);
   static std::string Fig8Dir(const ReportSettings& s, const std::string& base);
+  /// The --cache directory of the map, localize and relocalize steps: each log's ICP poses and
+  /// keypoints, computed by the first step that reads the log.
+  static std::string PreparationCache(const ReportSettings& s);
   static std::string Fig9Dir(const ReportSettings& s, const std::string& base,
                              const std::string& preset);
   static std::string SlamDir(const ReportSettings& s, const std::string& base);

@@ -45,6 +45,20 @@ void PrintLogWarnings(const CarmenLog& log) {
     fmt::print(stderr, "keyplace: warning: {}\n", warning);
 }
 
+void PrintInputsWarnings(const LogInputs& inputs) {
+  PrintLogWarnings(inputs.log);
+  for (const std::string& warning : inputs.cache_warnings) {
+    fmt::print(stderr, "keyplace: warning: cache entry {}\n", warning);
+  }
+  if (inputs.poses_from_cache || inputs.keypoints_from_cache) {
+    fmt::print(stderr, "keyplace: {} of {} read from the cache\n",
+               inputs.poses_from_cache && inputs.keypoints_from_cache
+                   ? "poses and keypoints"
+                   : (inputs.poses_from_cache ? "poses" : "keypoints"),
+               inputs.source_log);
+  }
+}
+
 void WriteJson(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }

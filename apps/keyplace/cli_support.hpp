@@ -29,6 +29,17 @@ inline constexpr const char* kSkipBadLinesHelp =
 /// stderr, one "keyplace: warning: ..." line each.
 void PrintLogWarnings(const CarmenLog& log);
 
+/// Help text of --cache (LogInputOptions::cache_dir).
+inline constexpr const char* kCacheHelp =
+    "Directory keeping the log's ICP poses and FLIRT keypoints between runs (created if "
+    "missing): a later run over the same log with the same settings reads them instead of "
+    "computing them; the results are the same bit for bit. Clear it after changing FLIRT or ICP "
+    "code";
+
+/// PrintLogWarnings of the inputs' log, the damaged cache entries and, when the cache gave the
+/// poses or keypoints, one line saying so.
+void PrintInputsWarnings(const LogInputs& inputs);
+
 /// The worker threads of --threads N: N, or every core when N is 0. Throws
 /// std::invalid_argument for N < 0.
 std::size_t WorkerThreads(int threads);

@@ -34,6 +34,7 @@ struct MapOptions {
   ConfigOptions config;
   bool overlap_only = false;
   bool skip_bad_lines = false;
+  std::string cache_dir;
   bool start_at_origin = false;
   int threads = 0;
 };
@@ -158,9 +159,10 @@ void RunMap(const MapOptions& options) {
   input_options.odometry = config.odometry;
   input_options.start_at_origin = options.start_at_origin;
   input_options.features = config.features;
+  input_options.cache_dir = options.cache_dir;
   ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());
-  PrintLogWarnings(inputs.log);
+  PrintInputsWarnings(inputs);
   Progress progress("mapping", inputs.log.scans.size());
   LogMap result = MapLog(inputs, config.mapping, [&](std::size_t next) { progress.Update(next); });
   progress.Finish();
@@ -215,6 +217,7 @@ void RegisterMapCommand(CLI::App& app) {
                       "Map only the scans A:B of the log (e.g. 0:700, the first part of a "
                       "time split); the map's scan indices stay those of the whole file");
   command->add_flag("--skip-bad-lines", options->skip_bad_lines, kSkipBadLinesHelp);
+  command->add_option("--cache", options->cache_dir, kCacheHelp);
   command->add_flag("--start-at-origin", options->start_at_origin,
                     "Express the map in the frame of its first scan's pose, as a robot's own "
                     "frame of one session (for keyplace merge)");

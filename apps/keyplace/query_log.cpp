@@ -27,6 +27,7 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
                       "Query scans A:B of the log (a time split: the map of --scans 0:A, the "
                       "queries from A:)");
   command->add_flag("--skip-bad-lines", options.skip_bad_lines, kSkipBadLinesHelp);
+  command->add_option("--cache", options.cache_dir, kCacheHelp);
   command
       ->add_option("--threads", options.threads,
                    "Worker threads (0 = all cores); the figures do not depend on it")
@@ -40,9 +41,10 @@ QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {
   query.input_options.poses = ParsePoseSource(options.poses);
   query.input_options.odometry = config.odometry;
   query.input_options.features = config.features;
+  query.input_options.cache_dir = options.cache_dir;
   ApplyScanRange(options.scans, query.input_options);
   query.inputs = PrepareLogInputs(options.log_path, query.input_options, StageProgressBar());
-  PrintLogWarnings(query.inputs.log);
+  PrintInputsWarnings(query.inputs);
   query.truth = LoadGroundTruth(query.inputs.log, query.inputs.first_scan, query.inputs.file_scans,
                                 options.truth_path, options.index_path, query.inputs.source_hash);
   return query;

@@ -20,7 +20,8 @@ struct QueryLogOptions {
   std::string index_path;
   std::string scans;
   bool skip_bad_lines = false;
-  int threads = 0;  // worker threads for keypoints and queries (WorkerThreads: 0 = all cores)
+  std::string cache_dir;  // --cache (LogInputOptions::cache_dir)
+  int threads = 0;        // worker threads for keypoints and queries (WorkerThreads: 0 = all cores)
 };
 
 /// Registers the options; `poses_help` says what the poses are used for.

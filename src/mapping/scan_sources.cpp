@@ -7,6 +7,12 @@
 #include <chrono>
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
+
+#include "common/config_fields.hpp"
+#include "config/section_tables.hpp"
+#include "io/atomic_file.hpp"
+#include "mapping/preparation_cache.hpp"
 
 namespace keyplace {
 
@@ -79,10 +85,80 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+template <typename Config>
+void AppendSettings(const std::string& section, const ConfigFields<Config>& fields,
+                    const Config& config, std::string& key) {
+  for (const auto& [name, value] : fields.ToKeyValues(config)) {
+    key.append(section).append(".").append(name).append("=").append(value).append("\n");
+  }
+}
+
+// Everything a cache entry of `kind` ("poses-icp" or "keypoints") depends on, spelled out.
+std::string CacheKey(const std::string& kind, const LogInputs& inputs,
+                     const LogInputOptions& options) {
+  const CarmenReadOptions& reading = options.reading;
+  std::string key = "keyplace preparation 1\n" + kind + "\nlog " + inputs.source_hash + "\nscans " +
+                    std::to_string(inputs.first_scan) + ":" +
+                    std::to_string(inputs.first_scan + inputs.log.scans.size()) + " of " +
+                    std::to_string(inputs.file_scans) + "\nreading flaser_max_range_m=" +
+                    FormatConfigDouble(reading.flaser_max_range_m) +
+                    " max_coordinate_m=" + FormatConfigDouble(reading.max_coordinate_m) +
+                    " pose_kind=" + std::to_string(static_cast<int>(reading.pose_kind)) +
+                    " skip_bad_lines=" + (reading.skip_bad_lines ? "1" : "0") + "\n";
+  AppendSettings("input", BagInputConfigFields(), reading.bag, key);
+  if (kind == "keypoints") AppendSettings("features", FlirtConfigFields(), options.features, key);
+  if (kind == "poses-icp") {
+    AppendSettings("odometry", ScanOdometryConfigFields(), options.odometry, key);
+  }
+  return key;
+}
+
+// The value of a cache entry: read from options.cache_dir when there, else computed and written
+// there. Returns whether it was read.
+template <typename Value>
+bool ReadOrCompute(const std::string& kind, const LogInputOptions& options, LogInputs& inputs,
+                   Value& value, const std::function<Value()>& compute,
+                   const std::function<std::string(const Value&)>& encode,
+                   const std::function<Value(const std::string&, std::size_t)>& decode) {
+  if (options.cache_dir.empty()) {
+    value = compute();
+    return false;
+  }
+  const std::string key = CacheKey(kind, inputs, options);
+  const std::string path = mapping_internal::CacheEntryPath(options.cache_dir, kind, key);
+  mapping_internal::CacheRead read = mapping_internal::ReadCacheEntry(path, key);
+  if (read.payload) {
+    try {
+      value = decode(*read.payload, inputs.log.scans.size());
+      return true;
+    } catch (const std::runtime_error& error) {
+      read.problem = error.what();
+    }
+  }
+  if (!read.problem.empty()) {
+    inputs.cache_warnings.push_back(path + ": " + read.problem + "; computed again");
+  }
+  value = compute();
+  mapping_internal::WriteCacheEntry(path, key, encode(value));
+  return false;
+}
+
+// Makes the cache directory and checks that entries can be written there, before any work.
+void PrepareCacheDir(const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) {
+    throw std::invalid_argument(dir + ": cannot make the cache directory (" + error.message() +
+                                ")");
+  }
+  CheckOutputPath(dir + "/keypoints-probe.bin", {});
+}
+
 }  // namespace
 
 LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options,
                            const StageProgress& progress) {
+  if (!options.cache_dir.empty()) PrepareCacheDir(options.cache_dir);
   auto start = std::chrono::steady_clock::now();
   LogInputs inputs;
   inputs.log = ReadCarmenLogWithScans(path, options.reading);
@@ -106,10 +182,19 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
       options.poses.value_or(inputs.log.corrected ? PoseSource::kCorrected : PoseSource::kIcp);
   if (options.compute_poses) {
     const std::string pose_stage = "poses (" + ToString(inputs.pose_source) + ")";
-    inputs.poses = ScanPoses(inputs.log, inputs.pose_source, options.odometry,
-                             [&](std::size_t done, std::size_t total) {
-                               if (progress) progress(pose_stage, done, total);
-                             });
+    const auto compute = [&] {
+      return ScanPoses(inputs.log, inputs.pose_source, options.odometry,
+                       [&](std::size_t done, std::size_t total) {
+                         if (progress) progress(pose_stage, done, total);
+                       });
+    };
+    if (inputs.pose_source == PoseSource::kIcp) {  // the others are read from the log
+      inputs.poses_from_cache = ReadOrCompute<std::vector<Pose2>>(
+          "poses-icp", options, inputs, inputs.poses, compute, mapping_internal::EncodePoses,
+          mapping_internal::DecodePoses);
+    } else {
+      inputs.poses = compute();
+    }
     inputs.start_at_origin = options.start_at_origin;
     if (options.start_at_origin) {
       const Pose2 T_first_world = inputs.poses.front().inverse();
@@ -120,11 +205,15 @@ LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& optio
 
   if (options.keypoints) {
     start = std::chrono::steady_clock::now();
-    const FlirtExtractor extractor(options.features);
-    inputs.keypoints =
-        ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
-          if (progress) progress("keypoints", done, total);
-        });
+    inputs.keypoints_from_cache = ReadOrCompute<std::vector<std::vector<Keypoint>>>(
+        "keypoints", options, inputs, inputs.keypoints,
+        [&] {
+          const FlirtExtractor extractor(options.features);
+          return ExtractKeypoints(inputs.log, extractor, [&](std::size_t done, std::size_t total) {
+            if (progress) progress("keypoints", done, total);
+          });
+        },
+        mapping_internal::EncodeKeypoints, mapping_internal::DecodeKeypoints);
     inputs.seconds_keypoints = SecondsSince(start);
   }
   return inputs;

@@ -102,6 +102,26 @@ for threads in 2 8; do
   done
 done
 
+# --cache: the second run reads the ICP poses and keypoints the first one wrote, and its figures
+# are those of a run without the cache.
+cd "$work/t2" || exit 1
+for run in plain first second; do
+  cache=()
+  [ "$run" = plain ] || cache=(--cache cache)
+  check "localize --poses icp ($run)" "$keyplace" localize --map map.kpm \
+    --log ../fr079-600.log.gz --poses icp --n-pos 20 --threads 2 "${cache[@]}" \
+    --json "icp-$run.json" --queries "icp-$run.tsv"
+  cp "$work/err" "icp-$run.err"
+done
+check "the first --cache run computes" test "$(grep -c 'read from the cache' icp-first.err)" = 0
+check "the second --cache run reads the cache" grep -q \
+  'poses and keypoints of fr079-600.log.gz read from the cache' icp-second.err
+for output in json tsv; do
+  check "icp-second.$output equals the run without cache" same_but_times "icp-plain.$output" \
+    "icp-second.$output"
+done
+cd "$work" || exit 1
+
 # The comparison compares something: answers were given and fixes reported.
 check "localize accepted answers" /usr/bin/python3 -c "
 import json, sys

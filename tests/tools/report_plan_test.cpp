@@ -42,7 +42,8 @@ TEST(ReportPlanTest, RelocalizesTheCorrectedLogAgainstItsOwnMap) {
   const ReportStep& step = steps[k];
   EXPECT_EQ(CommandLine(step),
             "keyplace relocalize --map /work/maps/fr079.kpm --log /data/fr079-corrected.log.gz "
-            "--self-match shared-scan --starts 50 --threads 0 --json /work/relocalize/fr079.json "
+            "--self-match shared-scan --starts 50 --threads 0 --cache /work/cache --json "
+            "/work/relocalize/fr079.json "
             "--figure "
             "/work/relocalize/fr079.png");
   EXPECT_EQ(step.needs,
@@ -63,7 +64,8 @@ TEST(ReportPlanTest, RelocalizesTheRawLogWithIcpOdometryAgainstTheCorrectedMap) 
   EXPECT_EQ(CommandLine(step),
             "keyplace relocalize --map /work/maps/intel.kpm --log /data/intel-raw.log.gz --poses "
             "icp --truth /data/intel-corrected.log.gz --index /data/intel-raw-to-corrected.tsv "
-            "--starts 50 --threads 0 --json /work/relocalize/intel-raw.json --figure "
+            "--starts 50 --threads 0 --cache /work/cache --json /work/relocalize/intel-raw.json "
+            "--figure "
             "/work/relocalize/intel-raw.png");
   EXPECT_EQ(step.needs, (std::vector<std::string>{"/work/maps/intel.kpm", "/data/intel-raw.log.gz",
                                                   "/data/intel-corrected.log.gz",
@@ -100,6 +102,22 @@ TEST(ReportPlanTest, LocalizeAndRelocalizeStepsUseTheReportsThreads) {
     EXPECT_EQ(*(threads + 1), "3") << step.id;
   }
   EXPECT_GT(steps_with_queries, 20);
+}
+
+// The raw logs are read by ten steps each: the first one's ICP poses and keypoints serve the rest.
+TEST(ReportPlanTest, EveryMapLocalizeAndRelocalizeStepSharesOnePreparationCache) {
+  const ReportSettings settings = Settings(false);
+  int cached = 0;
+  for (const ReportStep& step : PlanReport(settings)) {
+    const std::string& command = step.args[0];
+    if (command != "map" && command != "localize" && command != "relocalize") continue;
+    const auto cache = std::find(step.args.begin(), step.args.end(), "--cache");
+    ASSERT_NE(cache, step.args.end()) << step.id;
+    ASSERT_NE(cache + 1, step.args.end()) << step.id;
+    EXPECT_EQ(*(cache + 1), ReportArtefacts::PreparationCache(settings)) << step.id;
+    ++cached;
+  }
+  EXPECT_GT(cached, 30);
 }
 
 TEST(ReportPlanTest, RelocalizeStepsWithoutDataAreSkipped) {

@@ -1,0 +1,50 @@
+#pragma once
+// The preparation cache of PrepareLogInputs (LogInputOptions::cache): the ICP poses and the FLIRT
+// keypoints of a log kept in files, so that several runs over one log compute them once.
+//
+// An entry is one file, named by its kind and a hash of its key. The key spells out everything
+// the result depends on: the log's content (fingerprint), the kept scan range, the reading
+// options and the settings text of the caller (features, odometry, bag input). A file whose key
+// differs is another entry (a hash collision) and is replaced; a damaged file (bad header, short,
+// checksum mismatch, counts that do not fit the log) is reported and recomputed.
+//
+// File layout, native byte order (an entry written on another architecture is a miss):
+//   "KPPREP1\n" | u32 0x01020304 | u64 key bytes | key | u64 payload bytes | payload
+//   | u64 FNV-1a 64 of every byte before it.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "keyplace/common/pose2.hpp"
+#include "keyplace/features/keypoint.hpp"
+
+namespace keyplace::mapping_internal {
+
+/// dir/<kind>-<16 hex digits of the key's hash>.bin
+std::string CacheEntryPath(const std::string& dir, const std::string& kind, const std::string& key);
+
+/// What reading an entry found: its payload, or why there is none (`problem` is empty for a
+/// missing file or another key's entry, which are plain misses).
+struct CacheRead {
+  std::optional<std::string> payload;
+  std::string problem;
+};
+
+CacheRead ReadCacheEntry(const std::string& path, const std::string& key);
+
+/// Writes the entry atomically (temporary file, then rename). Throws std::runtime_error naming
+/// the path when it cannot be written.
+void WriteCacheEntry(const std::string& path, const std::string& key, const std::string& payload);
+
+std::string EncodePoses(const std::vector<Pose2>& poses);
+/// Throws std::runtime_error saying what does not fit when the payload is not `scans` poses.
+std::vector<Pose2> DecodePoses(const std::string& payload, std::size_t scans);
+
+std::string EncodeKeypoints(const std::vector<std::vector<Keypoint>>& keypoints);
+/// Throws std::runtime_error saying what does not fit when the payload is not keypoints of
+/// `scans` scans.
+std::vector<std::vector<Keypoint>> DecodeKeypoints(const std::string& payload, std::size_t scans);
+
+}  // namespace keyplace::mapping_internal
