@@ -33,8 +33,8 @@ void PrintLogWarnings(const CarmenLog& log);
 inline constexpr const char* kCacheHelp =
     "Directory keeping the log's ICP poses and FLIRT keypoints between runs (created if "
     "missing): a later run over the same log with the same settings reads them instead of "
-    "computing them; the results are the same bit for bit. Clear it after changing FLIRT or ICP "
-    "code";
+    "computing them; the results are the same bit for bit. Entries are keyed by the log's "
+    "content, the settings and the code that computes them";
 
 /// PrintLogWarnings of the inputs' log, the damaged cache entries and, when the cache gave the
 /// poses or keypoints, one line saying so.

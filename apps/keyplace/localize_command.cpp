@@ -169,6 +169,7 @@ void RunLocalize(const LocalizeOptions& options) {
     const LogInputs map_log = options.query.truth_path.empty()
                                   ? inputs
                                   : PrepareLogInputs(options.query.truth_path, map_options);
+    if (!options.query.truth_path.empty()) PrintInputsWarnings(map_log);
     std::vector<Place> scan_places = ScanPlaces(map_log);
     const std::vector<Submap> map_scans = ScanPlacesAsSubmaps(scan_places);
     places = scan_places.size();
@@ -204,6 +205,7 @@ void RunLocalize(const LocalizeOptions& options) {
   report.place = config.place;
   report.summary = Summarize(records, rank_by);
   report.preparation_seconds = preparation_seconds;
+  report.preparation_from_cache = inputs.poses_from_cache || inputs.keypoints_from_cache;
   PrintLocalizeReport(report);
   if (!options.queries_path.empty())
     WriteQueriesTsv(options.queries_path, records, inputs.first_scan);

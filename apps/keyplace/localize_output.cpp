@@ -118,8 +118,9 @@ void PrintLocalizeReport(const LocalizeReport& r) {
              ToString(s.rank_by));
   fmt::print(
       "time               {:.4f} s per query recognition, {:.4f} s submap building; "
-      "preparation (poses, keypoints) {:.1f} s\n",
-      s.seconds_per_query_mean, s.seconds_submap_building_mean, r.preparation_seconds);
+      "preparation (poses, keypoints) {:.1f} s{}\n",
+      s.seconds_per_query_mean, s.seconds_submap_building_mean, r.preparation_seconds,
+      r.preparation_from_cache ? " (from the cache)" : "");
   fmt::print("\n{:<18} {:>9} {:>7} {:>7} {:>9}\n", dataset, "Precision", "Recall", "#Scans",
              "Time (s)");
   if (const PaperLocalizationRow* paper = PaperRow(r)) {
@@ -209,6 +210,7 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["seconds_per_query_mean"] = s.seconds_per_query_mean;
   json["seconds_submap_building_mean"] = s.seconds_submap_building_mean;
   json["seconds_preparation"] = r.preparation_seconds;
+  json["preparation_from_cache"] = r.preparation_from_cache;
   json["rank_by"] = ToString(s.rank_by);
   json["p_gl"] = s.p_gl;
   json["p_cl"] = s.p_cl;

@@ -35,6 +35,7 @@ struct LocalizeReport {
   PlaceRecognitionConfig place;
   LocalizationSummary summary;
   double preparation_seconds = 0.0;
+  bool preparation_from_cache = false;  // the query log's poses or keypoints came from --cache
 };
 
 /// Warns on stderr when the map was not built from corrected poses, and when the truth log has

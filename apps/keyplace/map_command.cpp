@@ -126,6 +126,9 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   json["seconds_per_submap_mapping_only"] = result.seconds_per_submap_mapping;
   json["seconds_poses"] = inputs.seconds_poses;
   json["seconds_keypoints"] = inputs.seconds_keypoints;
+  // With --cache the two times above are those of reading the cache.
+  json["poses_from_cache"] = inputs.poses_from_cache;
+  json["keypoints_from_cache"] = inputs.keypoints_from_cache;
   json["seconds_mapping"] = result.timings.seconds_total;
   if (const PaperMappingRow* paper = PaperRow(options.input, options.overlap_only)) {
     json["paper"] = {{"table", paper->table},

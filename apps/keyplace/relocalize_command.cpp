@@ -81,8 +81,10 @@ void RunRelocalize(const RelocalizeOptions& options) {
   report.options =
       RelocalizationOptionsFor(config.evaluation, options.starts,
                                options.self_match == "shared-scan", report.query_log_is_map_log);
-  report.seconds_keypoints_per_scan =
-      inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());
+  if (!inputs.keypoints_from_cache) {
+    report.seconds_keypoints_per_scan =
+        inputs.seconds_keypoints / static_cast<double>(inputs.log.scans.size());
+  }
 
   Progress progress("starts", static_cast<std::size_t>(options.starts));
   report.records = RunRelocalization(map, inputs, truth, ToLocalizerConfig(config), report.options,

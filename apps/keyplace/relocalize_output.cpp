@@ -47,10 +47,11 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              s.wrong_fix_confidence_max, o.confident);
   fmt::print("lost         {} signals: {} on a correct track, {} on a wrong one\n", s.lost_signals,
              s.lost_on_correct_track, s.lost_on_wrong_track);
-  fmt::print(
-      "update       mean {:.2f} ms, max {:.1f} ms per AddScan with keypoints given; FLIRT "
-      "{:.2f} ms per scan\n",
-      1e3 * s.update_seconds_mean, 1e3 * s.update_seconds_max, 1e3 * r.seconds_keypoints_per_scan);
+  fmt::print("update       mean {:.2f} ms, max {:.1f} ms per AddScan with keypoints given; {}\n",
+             1e3 * s.update_seconds_mean, 1e3 * s.update_seconds_max,
+             r.seconds_keypoints_per_scan
+                 ? fmt::format("FLIRT {:.2f} ms per scan", 1e3 * *r.seconds_keypoints_per_scan)
+                 : std::string("keypoints read from the cache"));
   fmt::print("time         {:.1f} s\n", r.seconds_total);
 }
 
@@ -125,7 +126,9 @@ nlohmann::json RelocalizeJson(const RelocalizeReport& r) {
   json["distance_after_revisit_p90_m"] = s.distance_after_revisit_p90_m;
   json["update_seconds_mean"] = s.update_seconds_mean;
   json["update_seconds_max"] = s.update_seconds_max;
-  json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan;
+  json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan
+                                          ? nlohmann::json(*r.seconds_keypoints_per_scan)
+                                          : nlohmann::json(nullptr);
   json["lost_signals"] = s.lost_signals;
   json["lost_on_correct_track"] = s.lost_on_correct_track;
   json["lost_on_wrong_track"] = s.lost_on_wrong_track;

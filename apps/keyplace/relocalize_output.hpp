@@ -3,6 +3,7 @@
 // figures (keys read by scripts) and the figure of starts, paths and fixes.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,8 @@ struct RelocalizeReport {
   RelocalizationOptions options;
   std::vector<StartRecord> records;
   RelocalizationSummary summary;
-  double seconds_keypoints_per_scan = 0.0;
+  // FLIRT time per scan of the query log; none when its keypoints came from --cache.
+  std::optional<double> seconds_keypoints_per_scan;
   double seconds_total = 0.0;
 };
 

@@ -3,9 +3,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include <system_error>
 #include <type_traits>
 
 #include "io/atomic_file.hpp"
@@ -96,10 +98,16 @@ std::string CacheEntryPath(const std::string& dir, const std::string& kind,
 
 CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
   CacheRead read;
+  std::error_code status_error;
+  const auto status = std::filesystem::status(path, status_error);
+  if (status.type() == std::filesystem::file_type::not_found) return read;  // no entry yet
+  if (status.type() != std::filesystem::file_type::regular) {  // a FIFO would never end
+    read.problem = "is not a regular file";
+    return read;
+  }
   std::ifstream file(path, std::ios::binary);
-  if (!file) return read;  // no entry yet
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) {
+  if (!file.is_open() || file.bad()) {
     read.problem = "cannot be read";
     return read;
   }
@@ -107,12 +115,15 @@ CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
     read.problem = "is not a keyplace preparation cache entry";
     return read;
   }
+  std::uint32_t mark = 0;
+  std::memcpy(&mark, bytes.data() + kMagicBytes, 4);
+  if (mark != kByteOrderMark) {
+    read.problem = "was written with another byte order (or is damaged)";
+    return read;
+  }
   std::uint64_t checksum = 0;
   std::memcpy(&checksum, bytes.data() + bytes.size() - 8, 8);
   if (checksum != Fnv1a64(bytes.data(), bytes.size() - 8)) {
-    std::uint32_t mark = 0;
-    std::memcpy(&mark, bytes.data() + kMagicBytes, 4);
-    if (mark != kByteOrderMark) return read;  // written on another architecture: a miss
     read.problem = "fails its checksum (damaged or cut short)";
     return read;
   }

@@ -1,14 +1,16 @@
 #pragma once
-// The preparation cache of PrepareLogInputs (LogInputOptions::cache): the ICP poses and the FLIRT
-// keypoints of a log kept in files, so that several runs over one log compute them once.
+// The preparation cache of PrepareLogInputs (LogInputOptions::cache_dir): the ICP poses and the
+// FLIRT keypoints of a log kept in files, so that several runs over one log compute them once.
 //
 // An entry is one file, named by its kind and a hash of its key. The key spells out everything
-// the result depends on: the log's content (fingerprint), the kept scan range, the reading
-// options and the settings text of the caller (features, odometry, bag input). A file whose key
-// differs is another entry (a hash collision) and is replaced; a damaged file (bad header, short,
-// checksum mismatch, counts that do not fit the log) is reported and recomputed.
+// the result depends on (CacheKey in scan_sources.cpp): the code, the log's content, the kept scan
+// range, the reading options and the settings (features, odometry, bag input). A file whose key
+// differs is another entry (a hash collision) and is replaced; a damaged file (not a regular
+// file, bad header, short, checksum mismatch, counts that do not fit the log) is reported and
+// recomputed.
 //
-// File layout, native byte order (an entry written on another architecture is a miss):
+// File layout, native byte order (an entry written with another byte order is reported and
+// replaced):
 //   "KPPREP1\n" | u32 0x01020304 | u64 key bytes | key | u64 payload bytes | payload
 //   | u64 FNV-1a 64 of every byte before it.
 

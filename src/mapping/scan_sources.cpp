@@ -12,6 +12,7 @@
 #include "common/config_fields.hpp"
 #include "config/section_tables.hpp"
 #include "io/atomic_file.hpp"
+#include "keyplace_generated/preparation_code_hash.hpp"
 #include "mapping/preparation_cache.hpp"
 
 namespace keyplace {
@@ -89,22 +90,27 @@ template <typename Config>
 void AppendSettings(const std::string& section, const ConfigFields<Config>& fields,
                     const Config& config, std::string& key) {
   for (const auto& [name, value] : fields.ToKeyValues(config)) {
-    key.append(section).append(".").append(name).append("=").append(value).append("\n");
+    // The value's length first: a text value holding a newline cannot pass for another key.
+    key.append(section).append(".").append(name).append("=");
+    key.append(std::to_string(value.size())).append(":").append(value).append("\n");
   }
 }
 
-// Everything a cache entry of `kind` ("poses-icp" or "keypoints") depends on, spelled out.
+// Everything a cache entry of `kind` ("poses-icp" or "keypoints") depends on, spelled out: the
+// code that computes it (a hash of its sources made by the build), the log's content, the scans
+// kept and every setting.
 std::string CacheKey(const std::string& kind, const LogInputs& inputs,
                      const LogInputOptions& options) {
   const CarmenReadOptions& reading = options.reading;
-  std::string key = "keyplace preparation 1\n" + kind + "\nlog " + inputs.source_hash + "\nscans " +
-                    std::to_string(inputs.first_scan) + ":" +
-                    std::to_string(inputs.first_scan + inputs.log.scans.size()) + " of " +
+  std::string key = "keyplace preparation 1\ncode " KEYPLACE_PREPARATION_CODE_HASH "\n" + kind +
+                    "\nlog " + inputs.source_hash + "\nscans " + std::to_string(inputs.first_scan) +
+                    ":" + std::to_string(inputs.first_scan + inputs.log.scans.size()) + " of " +
                     std::to_string(inputs.file_scans) + "\nreading flaser_max_range_m=" +
                     FormatConfigDouble(reading.flaser_max_range_m) +
                     " max_coordinate_m=" + FormatConfigDouble(reading.max_coordinate_m) +
                     " pose_kind=" + std::to_string(static_cast<int>(reading.pose_kind)) +
-                    " skip_bad_lines=" + (reading.skip_bad_lines ? "1" : "0") + "\n";
+                    " skip_bad_lines=" + (reading.skip_bad_lines ? "1" : "0") +
+                    " keep_beams=" + (reading.keep_beams ? "1" : "0") + "\n";
   AppendSettings("input", BagInputConfigFields(), reading.bag, key);
   if (kind == "keypoints") AppendSettings("features", FlirtConfigFields(), options.features, key);
   if (kind == "poses-icp") {
@@ -139,7 +145,11 @@ bool ReadOrCompute(const std::string& kind, const LogInputOptions& options, LogI
     inputs.cache_warnings.push_back(path + ": " + read.problem + "; computed again");
   }
   value = compute();
-  mapping_internal::WriteCacheEntry(path, key, encode(value));
+  try {
+    mapping_internal::WriteCacheEntry(path, key, encode(value));
+  } catch (const std::runtime_error& error) {  // the results stand; only the next run pays
+    inputs.cache_warnings.push_back(std::string(error.what()) + "; not cached");
+  }
   return false;
 }
 

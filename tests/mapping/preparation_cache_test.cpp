@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -110,13 +112,20 @@ TEST(PreparationCache, AChangedSettingOrScanRangeIsAnotherEntry) {
   EXPECT_FALSE(other_icp.poses_from_cache);
   EXPECT_TRUE(other_icp.keypoints_from_cache);
 
+  LogInputOptions later = CachedIcpOptions(dir);  // the same number of scans, one later
+  later.first_scan = 11;
+  later.end_scan = 41;
+  const LogInputs shifted = PrepareLogInputs(BundledLog(), later);
+  EXPECT_FALSE(shifted.poses_from_cache);
+  EXPECT_FALSE(shifted.keypoints_from_cache);
+
   LogInputOptions shorter = CachedIcpOptions(dir);
   shorter.end_scan = 39;
   const LogInputs cut = PrepareLogInputs(BundledLog(), shorter);
   EXPECT_FALSE(cut.poses_from_cache);
   EXPECT_FALSE(cut.keypoints_from_cache);
-  EXPECT_EQ(Entries(dir, "keypoints").size(), 3u);
-  EXPECT_EQ(Entries(dir, "poses-icp").size(), 3u);
+  EXPECT_EQ(Entries(dir, "keypoints").size(), 4u);
+  EXPECT_EQ(Entries(dir, "poses-icp").size(), 4u);
 }
 
 TEST(PreparationCache, ADamagedEntryIsNamedAndComputedAgain) {
@@ -126,8 +135,11 @@ TEST(PreparationCache, ADamagedEntryIsNamedAndComputedAgain) {
   const fs::path poses = Entries(dir, "poses-icp").at(0);
   {  // one descriptor byte changed in place
     std::fstream file(keypoints, std::ios::in | std::ios::out | std::ios::binary);
-    file.seekp(static_cast<std::streamoff>(fs::file_size(keypoints) / 2));
-    file.put('\x7f');
+    const auto middle = static_cast<std::streamoff>(fs::file_size(keypoints) / 2);
+    file.seekg(middle);
+    const int byte = file.get();
+    file.seekp(middle);
+    file.put(static_cast<char>(byte ^ 0x5a));
   }
   fs::resize_file(poses, fs::file_size(poses) - 5);  // cut short
 
@@ -144,6 +156,36 @@ TEST(PreparationCache, ADamagedEntryIsNamedAndComputedAgain) {
   EXPECT_TRUE(again.poses_from_cache);
   EXPECT_TRUE(again.keypoints_from_cache);
   ExpectSamePreparation(reference, again);
+}
+
+// The key is kept in the entry: it names the code that computed it (a SHA-256 of the reading,
+// FLIRT and ICP sources, made by the build), so that changed code never reads old entries.
+TEST(PreparationCache, TheKeyNamesTheCodeTheLogAndTheSettings) {
+  const std::string dir = testing::MakeTempDir("prep_cache_code");
+  PrepareLogInputs(BundledLog(), CachedIcpOptions(dir));
+  std::ifstream file(Entries(dir, "keypoints").at(0), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(std::regex_search(bytes, std::regex("\ncode [0-9a-f]{64}\n")));
+  testing::ExpectContains(bytes, "log crc32:");
+  testing::ExpectContains(bytes, "scans 10:40 of ");
+  testing::ExpectContains(bytes, "features.min_peak=4:0.34\n");
+}
+
+// An entry path taken by something that is not a cache file: named, computed anyway, and the
+// entry that cannot be written is a warning, not a lost run.
+TEST(PreparationCache, AnEntryThatIsNotAFileIsNamedAndTheRunGoesOn) {
+  const std::string dir = testing::MakeTempDir("prep_cache_not_file");
+  const LogInputs reference = PrepareLogInputs(BundledLog(), CachedIcpOptions(dir));
+  const fs::path keypoints = Entries(dir, "keypoints").at(0);
+  fs::remove(keypoints);
+  fs::create_directory(keypoints);
+  const LogInputs run = PrepareLogInputs(BundledLog(), CachedIcpOptions(dir));
+  EXPECT_TRUE(run.poses_from_cache);
+  EXPECT_FALSE(run.keypoints_from_cache);
+  ASSERT_EQ(run.cache_warnings.size(), 2u);
+  testing::ExpectContains(run.cache_warnings[0], keypoints.string() + ": is not a regular file");
+  testing::ExpectContains(run.cache_warnings[1], "not cached");
+  ExpectSamePreparation(reference, run);
 }
 
 TEST(PreparationCache, AnEntryOfTheWrongSizeIsRefusedSayingWhat) {

@@ -60,11 +60,12 @@ struct LogInputOptions {
   // own frame starts where the session starts (a map of one session of a multi-session set).
   bool start_at_origin = false;
   // Non-empty: a directory (created if missing) that keeps the ICP poses and the keypoints of
-  // this log between runs, keyed by the log's content, the scan range and every setting they
-  // depend on (reading, bag input, odometry, features); a later preparation with the same key
-  // reads them instead of computing them. Entries are files of native doubles and floats, the
-  // results bit for bit. A changed FLIRT or ICP implementation is not part of the key: clear
-  // the directory after changing that code.
+  // this log between runs, keyed by the code that computes them (a hash of its sources taken by
+  // the build), the log's content (CarmenLog::fingerprint), the scan range and every setting
+  // they depend on (reading, bag input, odometry, features); a later preparation with the same
+  // key reads them instead of computing them. Entries are files of native doubles and floats,
+  // the results bit for bit, checked by a checksum against damage, not against tampering: the
+  // directory must be as trusted as the code.
   std::string cache_dir;
 };
 
@@ -88,13 +89,15 @@ struct LogInputs {
   double seconds_keypoints = 0.0;
   bool poses_from_cache = false;      // read from LogInputOptions::cache_dir
   bool keypoints_from_cache = false;  // read from LogInputOptions::cache_dir
-  // Cache entries found damaged (named, with what was wrong) and computed again.
+  // Cache entries found damaged (named, with what was wrong) and computed again, or that could
+  // not be written.
   std::vector<std::string> cache_warnings;
 };
 
 /// Reads `path` (throws std::invalid_argument when it holds no laser scan), cuts it to the range,
 /// computes the poses and the keypoints, or reads them from options.cache_dir (throws
-/// std::invalid_argument naming it when it cannot be made or written). `progress` may be empty.
+/// std::invalid_argument naming it when it cannot be made or is not writable; an entry that
+/// cannot be written later is a cache warning). `progress` may be empty.
 LogInputs PrepareLogInputs(const std::string& path, const LogInputOptions& options = {},
                            const StageProgress& progress = {});
 
