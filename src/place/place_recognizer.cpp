@@ -44,8 +44,9 @@ MappedOverlap MapAndOverlap(const std::vector<Eigen::Vector2d>& reference_positi
   Box reference_box;
   Box current_box;
   for (const auto& p : reference_positions) reference_box.Add(p);
+  const PointMapper ref_from_cur(T_ref_cur);
   for (const auto& p : current_positions) {
-    result.current_in_ref.push_back(T_ref_cur * p);
+    result.current_in_ref.push_back(ref_from_cur(p));
     current_box.Add(result.current_in_ref.back());
   }
   Box overlap;

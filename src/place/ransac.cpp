@@ -114,8 +114,9 @@ double ScoreAgainst(const NearestReference& reference, const std::vector<Eigen::
   if (inliers) inliers->clear();
   if (current.empty()) return 0.0;
   double score = 0.0;
+  const PointMapper ref_from_cur(T_ref_cur);
   for (std::size_t i = 0; i < current.size(); ++i) {
-    const auto [nearest, distance2] = reference.Nearest(T_ref_cur * current[i]);
+    const auto [nearest, distance2] = reference.Nearest(ref_from_cur(current[i]));
     if (nearest >= 0 && inliers) inliers->emplace_back(static_cast<int>(i), nearest);
     score += distance2;  // the threshold^2 when there is no inlier: the truncated (MSAC) cost
   }

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -165,7 +164,11 @@ TEST(PreparationCache, TheKeyNamesTheCodeTheLogAndTheSettings) {
   PrepareLogInputs(BundledLog(), CachedIcpOptions(dir));
   std::ifstream file(Entries(dir, "keypoints").at(0), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  EXPECT_TRUE(std::regex_search(bytes, std::regex("\ncode [0-9a-f]{64}\n")));
+  const std::size_t code = bytes.find("\ncode ");
+  ASSERT_NE(code, std::string::npos);
+  const std::string hash = bytes.substr(code + 6, 65);
+  EXPECT_EQ(hash.find_first_not_of("0123456789abcdef"), 64u) << hash;  // 64 hex digits, then \n
+  EXPECT_EQ(hash.back(), '\n');
   testing::ExpectContains(bytes, "log crc32:");
   testing::ExpectContains(bytes, "scans 10:40 of ");
   testing::ExpectContains(bytes, "features.min_peak=4:0.34\n");
