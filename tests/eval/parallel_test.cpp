@@ -20,6 +20,7 @@
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "support/bundled_map.hpp"
+#include "support/same_match.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -54,11 +55,7 @@ class ProgressWitness {
   std::set<std::thread::id> threads_;
 };
 
-void ExpectSamePose(const Pose2& a, const Pose2& b, const std::string& what) {
-  EXPECT_EQ(a.x, b.x) << what;
-  EXPECT_EQ(a.y, b.y) << what;
-  EXPECT_EQ(a.theta, b.theta) << what;
-}
+using testing::ExpectSamePose;
 
 std::vector<LocalizationQuery> QueriesAt(std::size_t threads, const std::vector<int>& starts,
                                          ProgressWitness* witness = nullptr) {
@@ -127,25 +124,7 @@ void ExpectSameRecord(const LocalizationRecord& p, const LocalizationRecord& s,
   EXPECT_EQ(p.evaluated_scan, s.evaluated_scan) << what;
   EXPECT_EQ(p.correct, s.correct) << what;
   EXPECT_EQ(p.verified_correct, s.verified_correct) << what;
-  const PlaceMatch& a = p.match;
-  const PlaceMatch& e = s.match;
-  EXPECT_EQ(a.verified, e.verified) << what;
-  EXPECT_EQ(a.found, e.found) << what;
-  EXPECT_EQ(a.ambiguous, e.ambiguous) << what;
-  EXPECT_EQ(a.place_index, e.place_index) << what;
-  EXPECT_EQ(a.place_id, e.place_id) << what;
-  ExpectSamePose(a.T_ref_cur, e.T_ref_cur, what);
-  ExpectSamePose(a.estimated_pose, e.estimated_pose, what);
-  EXPECT_EQ(a.pairs, e.pairs) << what;
-  EXPECT_EQ(a.consensus, e.consensus) << what;
-  EXPECT_EQ(a.gamma, e.gamma) << what;
-  EXPECT_EQ(a.score, e.score) << what;
-  EXPECT_EQ(a.second_score, e.second_score) << what;
-  EXPECT_EQ(a.confidence, e.confidence) << what;
-  EXPECT_EQ(a.candidates, e.candidates) << what;
-  EXPECT_EQ(a.candidates_verified, e.candidates_verified) << what;
-  EXPECT_EQ(a.candidates_accepted, e.candidates_accepted) << what;
-  EXPECT_EQ(a.places_excluded, e.places_excluded) << what;
+  testing::ExpectSameMatch(p.match, s.match, what);
 }
 
 TEST(ParallelQueries, RecordsAndSummaryAreTheSameAtOneAndTwoThreads) {

@@ -19,6 +19,7 @@
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 #include "support/bundled_map.hpp"
+#include "support/same_match.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -366,29 +367,6 @@ TEST(DescriptorIndex, NoneHasNoIndexAndEmptyMapsWork) {
   EXPECT_THROW(index.FindPairs({}, 0.4, std::vector<char>(2, 1), below), std::invalid_argument);
 }
 
-void ExpectSameMatch(const PlaceMatch& a, const PlaceMatch& b, const std::string& where) {
-  EXPECT_EQ(a.verified, b.verified) << where;
-  EXPECT_EQ(a.found, b.found) << where;
-  EXPECT_EQ(a.ambiguous, b.ambiguous) << where;
-  EXPECT_EQ(a.place_id, b.place_id) << where;
-  EXPECT_EQ(a.pairs, b.pairs) << where;
-  EXPECT_EQ(a.consensus, b.consensus) << where;
-  EXPECT_EQ(a.gamma, b.gamma) << where;
-  EXPECT_EQ(a.score, b.score) << where;
-  EXPECT_EQ(a.second_score, b.second_score) << where;
-  EXPECT_EQ(a.confidence, b.confidence) << where;
-  EXPECT_EQ(a.candidates, b.candidates) << where;
-  EXPECT_EQ(a.candidates_verified, b.candidates_verified) << where;
-  EXPECT_EQ(a.candidates_accepted, b.candidates_accepted) << where;
-  EXPECT_EQ(a.places_excluded, b.places_excluded) << where;
-  EXPECT_EQ(a.estimated_pose.x, b.estimated_pose.x) << where;
-  EXPECT_EQ(a.estimated_pose.y, b.estimated_pose.y) << where;
-  EXPECT_EQ(a.estimated_pose.theta, b.estimated_pose.theta) << where;
-  EXPECT_EQ(a.T_ref_cur.x, b.T_ref_cur.x) << where;
-  EXPECT_EQ(a.T_ref_cur.y, b.T_ref_cur.y) << where;
-  EXPECT_EQ(a.T_ref_cur.theta, b.T_ref_cur.theta) << where;
-}
-
 TEST(DescriptorIndex, RecognizerGivesTheSameMatchesOnRandomPlaces) {
   std::mt19937 rng(9);
   std::uniform_int_distribution<int> support(1, kBetaGridBins);
@@ -410,8 +388,8 @@ TEST(DescriptorIndex, RecognizerGivesTheSameMatchesOnRandomPlaces) {
         query.positions = places[q].positions;
         query.descriptors = places[q].descriptors;
         const auto exclude = [q](const Place& place) { return place.id == static_cast<int>(q); };
-        ExpectSameMatch(indexed.Recognize(query, exclude), oracle.Recognize(query, exclude),
-                        "query " + std::to_string(q));
+        testing::ExpectSameMatch(indexed.Recognize(query, exclude),
+                                 oracle.Recognize(query, exclude), "query " + std::to_string(q));
       }
     }
   }
@@ -441,8 +419,8 @@ TEST(DescriptorIndex, SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog) {
     ASSERT_EQ(records.size(), all ? expected.size() : every_fifth.size());
     for (std::size_t i = 0; i < records.size(); ++i) {
       const std::size_t e = all ? i : 5 * i;
-      ExpectSameMatch(records[i].match, expected[e].match,
-                      "start " + std::to_string(b.queries[e].start_scan));
+      testing::ExpectSameMatch(records[i].match, expected[e].match,
+                               "start " + std::to_string(b.queries[e].start_scan));
       if (all) found += records[i].match.found ? 1 : 0;
     }
   }
@@ -476,7 +454,7 @@ std::vector<PlaceMatch> ExpectSameAnswers(const std::vector<LocalizationQuery>& 
   EXPECT_EQ(answers.size(), expected.size());
   for (std::size_t i = 0; i < answers.size(); ++i) {
     const std::string where = what + ", start " + std::to_string(queries[i].start_scan);
-    ExpectSameMatch(answers[i], expected[i], where);
+    testing::ExpectSameMatch(answers[i], expected[i], where);
     EXPECT_EQ(answers[i].place_index, expected[i].place_index) << where;
     EXPECT_EQ(answers[i].reference_coverage, expected[i].reference_coverage) << where;
   }
