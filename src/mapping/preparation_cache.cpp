@@ -1,15 +1,17 @@
 #include "mapping/preparation_cache.hpp"
 
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 #include <type_traits>
+#include <utility>
 
+#include "common/fnv1a64.hpp"
 #include "io/atomic_file.hpp"
 
 namespace keyplace::mapping_internal {
@@ -21,15 +23,6 @@ constexpr std::uint32_t kByteOrderMark = 0x01020304;
 // header: magic, byte order mark, key length; then payload length and checksum.
 constexpr std::size_t kFixedBytes = kMagicBytes + 4 + 8 + 8 + 8;
 
-std::uint64_t Fnv1a64(const char* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<unsigned char>(data[i]);
-    hash *= 0x100000001b3ULL;
-  }
-  return hash;
-}
-
 template <typename T>
 void Append(std::string& out, T value) {
   static_assert(std::is_trivially_copyable_v<T>);
@@ -39,7 +32,7 @@ void Append(std::string& out, T value) {
 // Reads values from a payload front to back; running past its end is an error naming `what`.
 class Reader {
  public:
-  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+  explicit Reader(std::string_view bytes) : bytes_(bytes) {}
 
   template <typename T>
   T Next(const char* what) {
@@ -62,12 +55,13 @@ class Reader {
     }
     return static_cast<std::size_t>(count);
   }
-  std::string Take(std::size_t count) {  // count <= Left(), as Count checked
+  std::string_view Take(std::size_t count) {  // count <= Left(), as Count checked
     const std::size_t begin = at_;
     at_ += count;
     return bytes_.substr(begin, count);
   }
   std::size_t Left() const { return bytes_.size() - at_; }
+  std::size_t at() const { return at_; }
   void ExpectEnd() const {
     if (at_ != bytes_.size()) {
       throw std::runtime_error(std::to_string(bytes_.size() - at_) + " bytes after the last item");
@@ -75,7 +69,7 @@ class Reader {
   }
 
  private:
-  const std::string& bytes_;
+  std::string_view bytes_;
   std::size_t at_ = 0;
 };
 
@@ -90,10 +84,7 @@ void ExpectScans(std::size_t found, std::size_t scans, const char* what) {
 
 std::string CacheEntryPath(const std::string& dir, const std::string& kind,
                            const std::string& key) {
-  char hash[17];
-  std::snprintf(hash, sizeof(hash), "%016llx",
-                static_cast<unsigned long long>(Fnv1a64(key.data(), key.size())));
-  return dir + "/" + kind + "-" + hash + ".bin";
+  return dir + "/" + kind + "-" + Hex64(Fnv1a64Of(key.data(), key.size())) + ".bin";
 }
 
 CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
@@ -106,7 +97,7 @@ CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
     return read;
   }
   std::ifstream file(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   if (!file.is_open() || file.bad()) {
     read.problem = "cannot be read";
     return read;
@@ -123,12 +114,13 @@ CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
   }
   std::uint64_t checksum = 0;
   std::memcpy(&checksum, bytes.data() + bytes.size() - 8, 8);
-  if (checksum != Fnv1a64(bytes.data(), bytes.size() - 8)) {
+  if (checksum != Fnv1a64Of(bytes.data(), bytes.size() - 8)) {
     read.problem = "fails its checksum (damaged or cut short)";
     return read;
   }
-  const std::string body = bytes.substr(kMagicBytes + 4, bytes.size() - 8 - kMagicBytes - 4);
-  Reader reader(body);
+  // The body: after the magic and the byte order mark, before the checksum.
+  const std::size_t body_begin = kMagicBytes + 4;
+  Reader reader(std::string_view(bytes).substr(body_begin, bytes.size() - 8 - body_begin));
   try {
     const std::size_t key_bytes = reader.Count("key bytes", 1);
     if (reader.Take(key_bytes) != key) return read;  // another key with the same hash: a miss
@@ -138,7 +130,10 @@ CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
                      std::to_string(reader.Left());
       return read;
     }
-    read.payload = reader.Take(payload_bytes);
+    // The payload is the rest of the file but its checksum: kept in place, not copied.
+    bytes.resize(bytes.size() - 8);
+    bytes.erase(0, body_begin + reader.at());
+    read.payload = std::move(bytes);
   } catch (const std::runtime_error& error) {
     read.problem = error.what();
   }
@@ -153,7 +148,7 @@ void WriteCacheEntry(const std::string& path, const std::string& key, const std:
   bytes += key;
   Append(bytes, static_cast<std::uint64_t>(payload.size()));
   bytes += payload;
-  Append(bytes, Fnv1a64(bytes.data(), bytes.size()));
+  Append(bytes, Fnv1a64Of(bytes.data(), bytes.size()));
   WriteFileAtomically(path, [&](std::ostream& out) {
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   });

@@ -1,50 +1,15 @@
 #include "store/map_checksum.hpp"
 
-#include <array>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "common/fnv1a64.hpp"
 #include "store/map_schema.hpp"
 
 namespace keyplace {
-namespace {
-
-class Fnv1a64 {
- public:
-  void Bytes(const void* data, std::size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < size; ++k) {
-      state_ ^= bytes[k];
-      state_ *= kPrime;
-    }
-  }
-  // Fixed width and byte order, so that the checksum does not depend on the machine.
-  void Uint64(std::uint64_t value) {
-    std::array<unsigned char, 8> little_endian{};
-    for (std::size_t k = 0; k < little_endian.size(); ++k) {
-      little_endian[k] = static_cast<unsigned char>(value >> (8 * k));
-    }
-    Bytes(little_endian.data(), little_endian.size());
-  }
-  std::uint64_t value() const { return state_; }
-
- private:
-  static constexpr std::uint64_t kOffsetBasis = 14695981039346656037ULL;
-  static constexpr std::uint64_t kPrime = 1099511628211ULL;
-  std::uint64_t state_ = kOffsetBasis;
-};
-
-std::string Hex64(std::uint64_t value) {
-  std::array<char, 17> text{};
-  std::snprintf(text.data(), text.size(), "%016llx", static_cast<unsigned long long>(value));
-  return text.data();
-}
-
-}  // namespace
 
 std::string MapContentChecksum(sqlite3* db) {
   Fnv1a64 hash;
