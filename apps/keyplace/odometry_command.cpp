@@ -29,6 +29,7 @@ struct OdometryOptions {
   std::string out_path;
   std::string relations_path;
   std::string relation_errors_path;
+  std::string steps_path;
   std::string json_path;
   std::string corrected_path;
   std::string index_path;
@@ -41,6 +42,7 @@ struct OdometryOptions {
 void RunOdometry(const OdometryOptions& options) {
   CheckOutputs({{"--out", options.out_path},
                 {"--relation-errors", options.relation_errors_path},
+                {"--steps", options.steps_path},
                 {"--json", options.json_path}},
                {options.input, options.relations_path, options.corrected_path, options.index_path,
                 options.config.file});
@@ -70,6 +72,10 @@ void RunOdometry(const OdometryOptions& options) {
   json["log"] = options.input;
   json["config"] = ConfigJson(config);
   PrintOdometryRun(run);
+  const std::vector<OdometryStep> steps = OdometrySteps(run);
+  const OdometryStepDisagreement disagreement = SummarizeStepDisagreement(steps);
+  PrintStepDisagreement(disagreement);
+  json["step_disagreement"] = StepDisagreementJson(disagreement);
 
   if (!options.relations_path.empty()) {
     const std::vector<Relation> relations = ReadRelations(options.relations_path);
@@ -97,6 +103,7 @@ void RunOdometry(const OdometryOptions& options) {
   }
 
   if (!options.out_path.empty()) WriteTrajectoryTsv(options.out_path, run.icp_trajectory);
+  if (!options.steps_path.empty()) WriteStepsTsv(options.steps_path, steps);
   if (!options.json_path.empty()) WriteJson(options.json_path, json);
 }
 
@@ -128,10 +135,16 @@ void RegisterOdometryCommand(CLI::App& app) {
   command
       ->add_option("--relations", options->relations_path,
                    "Kümmerle relation file (t_a t_b dx dy dz droll dpitch dyaw; times are "
-                   "ipc timestamps of the raw log, matched exactly)")
+                   "ipc timestamps of the raw log, each matched to the scan with the nearest "
+                   "stamp within evaluation.relation_stamp_tolerance_s, default 0.1 ms)")
       ->check(CLI::ExistingFile);
   command->add_option("--relation-errors", options->relation_errors_path,
                       "with --relations: write the error of every matched relation as TSV");
+  command->add_option("--steps", options->steps_path,
+                      "write one TSV row per scan: ICP status, inlier ratio, "
+                      "residual, the step as ICP estimated it and as the odometry measured it "
+                      "(earlier robot frame) and how far they part, to find where scan matching "
+                      "and odometry disagree");
   command
       ->add_option("--corrected", options->corrected_path,
                    "corrected log (ROBOTLASER1 + VERTEX2) for drift: consecutive relative error "

@@ -1,6 +1,7 @@
 #include "odometry_output.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <ostream>
 #include <utility>
 
@@ -11,6 +12,8 @@
 
 namespace keyplace::cli {
 namespace {
+
+double RadToDeg(double rad) { return rad * 180.0 / M_PI; }
 
 void PrintStatsRow(const std::string& label, const ErrorStats& s) {
   if (s.count == 0) {
@@ -50,6 +53,28 @@ void PrintOdometryRun(const OdometryRun& run) {
   fmt::print("key scans       {}\n", s.keyframes);
   fmt::print("time per scan   {:.3f} ms mean, {:.3f} ms max ({:.1f} s in total)\n",
              1e3 * s.seconds_per_scan_mean, 1e3 * s.seconds_per_scan_max, s.seconds_total);
+}
+
+void PrintStepDisagreement(const OdometryStepDisagreement& summary) {
+  if (summary.steps == 0) {
+    fmt::print("ICP vs odometry no step where ICP converged between two odometry poses\n");
+    return;
+  }
+  fmt::print(
+      "ICP vs odometry median {:.3f} m, {:.2f} deg per step; 99 % below {:.3f} m, {:.2f} deg "
+      "({} steps where ICP converged)\n",
+      summary.median_m, RadToDeg(summary.median_rad), summary.p99_m, RadToDeg(summary.p99_rad),
+      summary.steps);
+}
+
+nlohmann::json StepDisagreementJson(const OdometryStepDisagreement& summary) {
+  nlohmann::json json = {{"steps", summary.steps}};
+  const bool any = summary.steps > 0;
+  json["median_m"] = any ? nlohmann::json(summary.median_m) : nlohmann::json(nullptr);
+  json["p99_m"] = any ? nlohmann::json(summary.p99_m) : nlohmann::json(nullptr);
+  json["median_deg"] = any ? nlohmann::json(RadToDeg(summary.median_rad)) : nlohmann::json(nullptr);
+  json["p99_deg"] = any ? nlohmann::json(RadToDeg(summary.p99_rad)) : nlohmann::json(nullptr);
+  return json;
 }
 
 nlohmann::json OdometryRunJson(const OdometryRun& run) {
@@ -127,6 +152,28 @@ void WriteRelationErrorsTsv(const std::string& path, const std::vector<Relation>
                            odo[j].error.rotation_deg);
       } else {
         out << "nan\tnan\n";
+      }
+    }
+  });
+}
+
+void WriteStepsTsv(const std::string& path, const std::vector<OdometryStep>& steps) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "# scan_index\ttimestamp_s\tstatus\tinlier_ratio\tresidual_rms_m\titerations\t"
+           "degenerate\ticp_dx_m\ticp_dy_m\ticp_dtheta_rad\todometry_dx_m\todometry_dy_m\t"
+           "odometry_dtheta_rad\tdisagreement_m\tdisagreement_deg\n";
+    for (const OdometryStep& step : steps) {
+      const Pose2& icp = step.T_previous_current_icp;
+      out << fmt::format("{}\t{:.6f}\t{}\t{:.4f}\t{:.5f}\t{}\t{:d}\t{:.6f}\t{:.6f}\t{:.6f}\t",
+                         step.scan_index, step.timestamp_s, ToString(step.status),
+                         step.inlier_ratio, step.residual_rms_m, step.iterations,
+                         step.degenerate ? 1 : 0, icp.x, icp.y, icp.theta);
+      if (step.T_previous_current_odometry) {
+        const Pose2& odometry = *step.T_previous_current_odometry;
+        out << fmt::format("{:.6f}\t{:.6f}\t{:.6f}\t{:.6f}\t{:.4f}\n", odometry.x, odometry.y,
+                           odometry.theta, step.disagreement_m, RadToDeg(step.disagreement_rad));
+      } else {
+        out << "nan\tnan\tnan\tnan\tnan\n";
       }
     }
   });

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstddef>
 #include <numeric>
 #include <stdexcept>
 
+#include "common/quantile.hpp"
 #include "keyplace/io/timestamps.hpp"
 
 namespace keyplace {
@@ -126,6 +129,57 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
   run.stats.missing_odometry = missing_odometry;
   run.stats.seconds_total = seconds_total;
   return run;
+}
+
+std::vector<OdometryStep> OdometrySteps(const OdometryRun& run) {
+  std::vector<OdometryStep> steps;
+  steps.reserve(run.results.size());
+  for (std::size_t k = 0; k < run.results.size(); ++k) {
+    const ScanOdometryResult& current = run.results[k];
+    OdometryStep step;
+    step.scan_index = run.scan_index[k];
+    step.timestamp_s = current.timestamp_s;
+    step.status = current.status;
+    step.inlier_ratio = current.inlier_ratio;
+    step.residual_rms_m = current.residual_rms_m;
+    step.iterations = current.iterations;
+    step.degenerate = current.degenerate;
+    if (k > 0) {
+      const ScanOdometryResult& previous = run.results[k - 1];
+      step.T_previous_current_icp = Between(previous.T_world_robot, current.T_world_robot);
+      const std::optional<Pose2>& odometry_before = run.odometry_by_scan[run.scan_index[k - 1]];
+      const std::optional<Pose2>& odometry_now = run.odometry_by_scan[step.scan_index];
+      if (odometry_before && odometry_now) {
+        step.T_previous_current_odometry = Between(*odometry_before, *odometry_now);
+        const Pose2 disagreement =
+            Between(*step.T_previous_current_odometry, step.T_previous_current_icp);
+        step.disagreement_m = std::hypot(disagreement.x, disagreement.y);
+        step.disagreement_rad = std::abs(disagreement.theta);
+      }
+    }
+    steps.push_back(step);
+  }
+  return steps;
+}
+
+OdometryStepDisagreement SummarizeStepDisagreement(const std::vector<OdometryStep>& steps) {
+  std::vector<double> translation_m;
+  std::vector<double> rotation_rad;
+  for (const OdometryStep& step : steps) {
+    const bool converged = step.status == ScanOdometryStatus::kRegistered ||
+                           step.status == ScanOdometryStatus::kRecovered;
+    if (!converged || !step.T_previous_current_odometry) continue;
+    translation_m.push_back(step.disagreement_m);
+    rotation_rad.push_back(step.disagreement_rad);
+  }
+  OdometryStepDisagreement summary;
+  summary.steps = translation_m.size();
+  if (translation_m.empty()) return summary;
+  summary.median_m = Quantile(translation_m, 0.5);
+  summary.p99_m = Quantile(translation_m, 0.99);
+  summary.median_rad = Quantile(rotation_rad, 0.5);
+  summary.p99_rad = Quantile(rotation_rad, 0.99);
+  return summary;
 }
 
 OdometryRelationErrors EvaluateOdometryRelations(const OdometryRun& run,

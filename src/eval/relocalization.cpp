@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "common/quantile.hpp"
 #include "eval/parallel_progress.hpp"
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/localization.hpp"
@@ -203,16 +204,6 @@ class StartRun {
   StartRecord record_;
   std::optional<Pose2> previous_T_world_odom_;
 };
-
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double position = q * static_cast<double>(values.size() - 1);
-  const auto low = static_cast<std::size_t>(std::floor(position));
-  const std::size_t high = std::min(low + 1, values.size() - 1);
-  const double fraction = position - static_cast<double>(low);
-  return values[low] + fraction * (values[high] - values[low]);
-}
 
 }  // namespace
 

@@ -50,7 +50,49 @@ import json, sys
 j = json.load(open(sys.argv[1]))
 assert j['config']['input']['laser_pose'] == '-0.04,0,0' and j['submaps'] > 0, j['config']['input']
 " "$work/map.json" && ok || fail "map JSON records input.laser_pose"
-check "odometry bag" "$keyplace" odometry "$bag" --scans 0:300
+check "odometry bag" "$keyplace" odometry "$bag" --scans 0:300 --steps "$work/steps.tsv" \
+  --json "$work/odo.json" --out "$work/icp.tsv"
+grep -qE '^ICP vs odometry median [0-9.]+ m, [0-9.]+ deg per step' "$work/out" && ok ||
+  fail "odometry prints how far ICP and odometry part"
+/usr/bin/python3 - "$work/odo.json" "$work/steps.tsv" <<'PY' && ok || fail "odometry --steps"
+import json, statistics, sys
+j = json.load(open(sys.argv[1]))
+rows = [l.rstrip('\n').split('\t') for l in open(sys.argv[2]) if not l.startswith('#')]
+assert len(rows) == 300 and rows[0][2] == 'first_scan', len(rows)
+converged = [float(r[13]) for r in rows if r[2] in ('registered', 'recovered')]
+d = j['step_disagreement']
+assert d['steps'] == len(converged) > 250, (d, len(converged))
+assert abs(d['median_m'] - statistics.median(converged)) < 1e-5, (d, statistics.median(converged))
+assert all(float(r[13]) == 0 for r in rows if r[2].startswith('fallback')), 'fallback is odometry'
+PY
+# Replaying the steps as ICP took them gives the ICP trajectory back (in its first pose's frame);
+# as the odometry measured them, another one.
+replay="$source_dir/scripts/replay_steps.py"
+check "replay icp" python3 "$replay" "$work/steps.tsv" --out "$work/replay_icp.tsv"
+check "replay odometry" python3 "$replay" "$work/steps.tsv" --rule odometry \
+  --out "$work/replay_odometry.tsv"
+/usr/bin/python3 - "$work/icp.tsv" "$work/replay_icp.tsv" "$work/replay_odometry.tsv" <<'PY' && ok ||
+import math, sys
+def poses(path):
+    return [tuple(map(float, l.split()[:4])) for l in open(path) if not l.startswith('#')]
+icp, replayed, odometry = (poses(p) for p in sys.argv[1:])
+t0, x0, y0, a0 = icp[0]
+def relative(p):
+    dx, dy = p[1] - x0, p[2] - y0
+    return (math.cos(a0) * dx + math.sin(a0) * dy, -math.sin(a0) * dx + math.cos(a0) * dy)
+assert len(icp) == len(replayed) == 300, (len(icp), len(replayed))
+worst = max(math.dist(relative(p), q[1:3]) for p, q in zip(icp, replayed))
+assert worst < 1e-3, worst
+assert all(p[0] == q[0] for p, q in zip(icp, replayed)), 'stamps'
+apart = max(math.dist(p[1:3], q[1:3]) for p, q in zip(replayed, odometry))
+assert apart > 0.05, apart
+PY
+  fail "replayed ICP steps are the ICP trajectory"
+head -5 "$work/steps.tsv" >"$work/cut_steps.tsv"
+printf '7\t1.0\tregistered\n' >>"$work/cut_steps.tsv"
+fails_with "replay names a bad line" "cut_steps.tsv:6: 3 columns" python3 "$replay" \
+  "$work/cut_steps.tsv"
+fails_with "replay bad rule" "unknown rule" python3 "$replay" "$work/steps.tsv" --rule blend:2
 check "dump-config bag flags" "$keyplace" dump-config --scan-topic /base_scan
 grep -qF 'scan_topic: /base_scan' "$work/out" && ok || fail "--scan-topic sets input.scan_topic"
 

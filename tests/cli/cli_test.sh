@@ -41,16 +41,26 @@ assert len(j['keypoints_per_level']) == 3 and j['config']['features']['num_scale
 
 # The bundled log is corrected (no odometry poses): ICP starts from zero motion.
 check "odometry" "$keyplace" odometry "$log" --scans 0:100 --set odometry.icp.kernel=huber \
-  --local-dt 2 --out "$work/odo.tsv" --json "$work/odo.json"
+  --local-dt 2 --out "$work/odo.tsv" --steps "$work/steps.tsv" --json "$work/odo.json"
 check "odometry json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['scans'] == 100 and j['scans_in_log'] == 1464 and j['missing_odometry'] == 100, j
+# Without odometry there is nothing for ICP to disagree with: no figure, not a zero.
+d=j['step_disagreement']
+assert d['steps'] == 0 and d['median_m'] is None and d['p99_deg'] is None, d
+rows=[l.rstrip('\\n').split('\\t') for l in open(sys.argv[2]) if not l.startswith('#')]
+assert len(rows) == 100 and [int(r[0]) for r in rows] == list(range(100)), len(rows)
+assert rows[0][2] == 'first_scan', rows[0]
+assert sum(r[2] == 'registered' for r in rows) == j['registered'], j['registered']
+assert sum(r[2] == 'fallback_not_converged' for r in rows) == j['not_converged']
+assert all(r[10:] == ['nan'] * 5 for r in rows), rows[0]
 assert j['registered'] + j['recovered'] + j['not_converged'] + j['fallback_correction_too_large'] \
     + j['fallback_too_few_points'] == 99, j
 c=j['config']
 assert c['odometry']['icp']['kernel'] == 'huber', c['odometry']
-assert float(c['evaluation']['local_relation_max_dt_s']) == 2, c['evaluation']" "$work/odo.json"
+assert float(c['evaluation']['local_relation_max_dt_s']) == 2, c['evaluation']" "$work/odo.json" \
+  "$work/steps.tsv"
 check "odometry tsv rows" test "$(($(wc -l <"$work/odo.tsv") - 1))" = 100
 # Timestamps kept to 6 digits (rounded to 1000 s) cannot order the scans: info says so, odometry
 # by time refuses and points to --order file, which works.

@@ -197,6 +197,71 @@ TEST(OdometryEvaluationTest, RunRegistersInLoggerOrderAsAPlainScanOdometryLoopWo
             0.1);
 }
 
+TEST(OdometryEvaluationTest, StepsSetTheIcpStepBesideTheOdometryStepItCorrected) {
+  // The odometry overstates every 0.1 m step by 5 % and every turn by 0.5 deg; ICP measures the
+  // true step, so a converged step parts from the odometry by about 5 mm and 0.5 deg.
+  Drive drive = MakeDrive(30, /*drifting=*/true);
+  drive.scans[12].odometry_pose.reset();
+  const OdometryRun run = RunScanOdometry(drive.scans, ScanOdometryConfig{});
+  const std::vector<OdometryStep> all_steps = OdometrySteps(run);
+  ASSERT_EQ(all_steps.size(), 30u);
+  EXPECT_EQ(all_steps[0].status, ScanOdometryStatus::kFirstScan);
+  EXPECT_EQ(all_steps[0].scan_index, run.scan_index[0]);
+  EXPECT_EQ(TranslationNorm(all_steps[0].T_previous_current_icp), 0.0);
+  EXPECT_FALSE(all_steps[0].T_previous_current_odometry.has_value());
+  const std::vector<OdometryStep> steps(all_steps.begin() + 1, all_steps.end());
+  std::size_t with_odometry = 0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const OdometryStep& step = steps[k];
+    const std::size_t before = run.scan_index[k];
+    EXPECT_EQ(step.scan_index, run.scan_index[k + 1]);
+    EXPECT_EQ(step.timestamp_s, run.results[k + 1].timestamp_s);
+    EXPECT_EQ(step.status, run.results[k + 1].status);
+    const Pose2 icp = Between(run.results[k].T_world_robot, run.results[k + 1].T_world_robot);
+    EXPECT_NEAR(step.T_previous_current_icp.x, icp.x, 1e-12);
+    EXPECT_NEAR(step.T_previous_current_icp.theta, icp.theta, 1e-12);
+    if (before == 12 || step.scan_index == 12) {
+      EXPECT_FALSE(step.T_previous_current_odometry.has_value()) << k;
+      continue;
+    }
+    ASSERT_TRUE(step.T_previous_current_odometry.has_value()) << k;
+    ++with_odometry;
+    EXPECT_NEAR(step.T_previous_current_odometry->x, 0.105, 1e-9) << k;
+    EXPECT_NEAR(step.T_previous_current_odometry->theta, DegToRad(5.0), 1e-9) << k;
+    if (step.status == ScanOdometryStatus::kRegistered) {
+      EXPECT_NEAR(step.disagreement_rad, DegToRad(0.5), DegToRad(0.3)) << k;
+      EXPECT_NEAR(step.disagreement_m, 0.005, 0.004) << k;
+    }
+  }
+  EXPECT_EQ(with_odometry, 27u);
+  const OdometryStepDisagreement summary = SummarizeStepDisagreement(all_steps);
+  EXPECT_GE(summary.steps, 25u);
+  EXPECT_LE(summary.steps, 27u);
+  EXPECT_NEAR(summary.median_rad, DegToRad(0.5), DegToRad(0.2));
+  EXPECT_NEAR(summary.median_m, 0.005, 0.003);
+  EXPECT_GE(summary.p99_rad, summary.median_rad);
+
+  // Exact odometry: nothing to correct, the steps agree.
+  const OdometryRun exact = RunScanOdometry(MakeDrive(30, /*drifting=*/false).scans, {});
+  const OdometryStepDisagreement agreed = SummarizeStepDisagreement(OdometrySteps(exact));
+  EXPECT_GE(agreed.steps, 27u);
+  EXPECT_LT(agreed.median_rad, DegToRad(0.1));
+  EXPECT_LT(agreed.median_m, 0.002);
+}
+
+TEST(OdometryEvaluationTest, StepsWithoutOdometryGiveNoDisagreementFigure) {
+  Drive drive = MakeDrive(6, /*drifting=*/false);
+  for (LogScan& scan : drive.scans) scan.odometry_pose.reset();
+  const OdometryRun run = RunScanOdometry(drive.scans, ScanOdometryConfig{});
+  const std::vector<OdometryStep> steps = OdometrySteps(run);
+  ASSERT_EQ(steps.size(), 6u);
+  for (const OdometryStep& step : steps) EXPECT_FALSE(step.T_previous_current_odometry);
+  const OdometryStepDisagreement summary = SummarizeStepDisagreement(steps);
+  EXPECT_EQ(summary.steps, 0u);
+  EXPECT_EQ(summary.median_m, 0.0);
+  EXPECT_TRUE(OdometrySteps(RunScanOdometry({}, ScanOdometryConfig{})).empty());
+}
+
 TEST(OdometryEvaluationTest, RangeCutsTheProcessingOrderNotTheFileOrder) {
   const Drive drive = MakeDrive(12, /*drifting=*/false);
   OdometryRunOptions options;

@@ -86,6 +86,42 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
                             const OdometryRunOptions& options = {},
                             const OdometryProgress& progress = {});
 
+/// One step of a run: a registered scan against the scan before it in processing order, as ICP
+/// estimated it and as the wheel odometry measured it, so that the places where the two part can
+/// be found (keyplace odometry --steps; docs/SLAM.md, "The hospital bag"). The run's first scan
+/// is a step of zero from nowhere (identity, no odometry step).
+struct OdometryStep {
+  std::size_t scan_index = 0;  // the later scan, file order
+  double timestamp_s = 0.0;    // its ipc stamp
+  ScanOdometryStatus status = ScanOdometryStatus::kRegistered;
+  double inlier_ratio = 0.0;
+  double residual_rms_m = 0.0;
+  int iterations = 0;
+  bool degenerate = false;
+  Pose2 T_previous_current_icp;  // the step in the earlier scan's robot frame, as estimated
+  // The step as the wheel odometry measured it, when both scans have an odometry pose.
+  std::optional<Pose2> T_previous_current_odometry;
+  // T_previous_current_odometry^-1 * T_previous_current_icp: how far the estimate leaves the
+  // odometry in this step (translation norm and |angle|); 0 for a scan that fell back.
+  double disagreement_m = 0.0;
+  double disagreement_rad = 0.0;
+};
+
+/// The steps of a run, one per registered scan (run.results order).
+std::vector<OdometryStep> OdometrySteps(const OdometryRun& run);
+
+/// How far ICP and odometry part per step, over the steps with odometry where ICP converged
+/// (registered or recovered; a fallback is the odometry itself and would only add zeros).
+struct OdometryStepDisagreement {
+  std::size_t steps = 0;  // steps counted
+  double median_m = 0.0;
+  double p99_m = 0.0;
+  double median_rad = 0.0;
+  double p99_rad = 0.0;
+};
+/// Quantiles interpolated between order statistics; all zero when no step qualifies.
+OdometryStepDisagreement SummarizeStepDisagreement(const std::vector<OdometryStep>& steps);
+
 /// The relation error of both trajectories of a run.
 struct OdometryRelationErrors {
   RelationErrorReport icp;
