@@ -195,6 +195,73 @@ TEST(ScanOdometryTest, CorridorDoesNotSlideAwayFromOdometry) {
   EXPECT_TRUE(last.degenerate);
 }
 
+// A 5 m wide corridor closed by an end wall 18-22 m ahead, seen by a scanner with 1 deg beams:
+// on the end wall the beams of one scan land 0.31-0.38 m apart, too far for a normal
+// (icp.normal_max_neighbour_distance_m 0.3), so within one scan nothing fixes the position
+// along the corridor. The robot weaves by a fraction of a degree, so the key scans of the local
+// map sample the end wall in between each other's beams. The odometry overstates every 0.1 m
+// step by 5 %.
+struct SparseEndWallRun {
+  double truth_x_m = 0.0;
+  double odometry_x_m = 0.0;
+  ScanOdometryResult last;
+  int measured_along_axis = 0;  // registered scans whose points fixed every direction
+};
+
+SparseEndWallRun DriveTowardsASparseEndWall(bool sparse_normals_from_map) {
+  const std::vector<testing::Segment> world = {{{-2.0, -2.5}, {22.0, -2.5}},
+                                               {{-2.0, 2.5}, {22.0, 2.5}},
+                                               {{22.0, -2.5}, {22.0, 2.5}},
+                                               {{-2.0, -2.5}, {-2.0, 2.5}}};
+  ScanOptions options;
+  options.beams = 180;
+  options.fov_rad = M_PI;
+  options.max_range_m = 25.0;
+  options.range_noise_m = 0.005;
+  ScanOdometryConfig config;
+  config.sparse_normals_from_map = sparse_normals_from_map;
+  ScanOdometry odometry(config);
+  std::mt19937 rng(5);
+  SparseEndWallRun run;
+  Pose2 odometry_pose;
+  Pose2 previous_truth;
+  for (int i = 0; i < 40; ++i) {
+    const Pose2 truth(0.1 * i, 0.0, DegToRad(0.6) * std::sin(0.9 * i));
+    if (i > 0) {
+      const Pose2 step = Between(previous_truth, truth);
+      odometry_pose = odometry_pose * Pose2(step.x * 1.05, step.y * 1.05, step.theta);
+    } else {
+      odometry_pose = truth;
+    }
+    previous_truth = truth;
+    LogScan scan;
+    static_cast<LaserScan&>(scan) = CastScan(world, truth, options, &rng);
+    scan.timestamp_s = 10.0 + 0.1 * i;
+    run.last = odometry.Add(scan, odometry_pose);
+    const bool registered = run.last.status == ScanOdometryStatus::kRegistered;
+    run.measured_along_axis += (registered && !run.last.degenerate) ? 1 : 0;
+    run.truth_x_m = truth.x;
+    run.odometry_x_m = odometry_pose.x;
+  }
+  return run;
+}
+
+TEST(ScanOdometryTest, SparseFarWallGetsItsNormalsFromTheLocalMap) {
+  const SparseEndWallRun with_map = DriveTowardsASparseEndWall(true);
+  const SparseEndWallRun per_scan = DriveTowardsASparseEndWall(false);
+  ASSERT_GT(with_map.odometry_x_m - with_map.truth_x_m, 0.18);  // odometry 0.195 m long
+
+  // Normals from single scans only: the end wall is unused, the corridor's axis is held at the
+  // odometry, and its error stays.
+  EXPECT_NEAR(per_scan.last.T_world_robot.x, per_scan.odometry_x_m, 0.03);
+  EXPECT_TRUE(per_scan.last.degenerate);
+  // From the local map: the end wall fixes the axis, the estimate follows the truth.
+  EXPECT_NEAR(with_map.last.T_world_robot.x, with_map.truth_x_m, 0.04);
+  EXPECT_FALSE(with_map.last.degenerate);
+  EXPECT_GT(with_map.measured_along_axis, 30);
+  EXPECT_NEAR(with_map.last.T_world_robot.y, 0.0, 0.02);
+}
+
 TEST(ScanOdometryTest, EmptyScanFallsBackToOdometryAndIsFlagged) {
   const auto world = testing::IrregularRoom();
   ScanOptions options;

@@ -36,6 +36,14 @@ struct ScanOdometryConfig {
   // keyframe_translation_m or turned keyframe_rotation_rad since the last key scan; a stationary
   // robot therefore does not wash the map out with copies of one view.
   int local_map_scans = 10;
+  // A key scan's point gets its normal from a line fitted within its own scan (no cross-scan
+  // noise). Where that scan is too sparse for a fit (beams further apart than
+  // icp.normal_max_neighbour_distance_m: beyond 8.6 m with 1 deg beams, 17 m with 0.5 deg),
+  // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
+  // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
+  // default: better relation errors on every log, but one odometry glitch on Intel is no longer
+  // absorbed (docs/REGISTRATION.md, "Normals from the local map").
+  bool sparse_normals_from_map = false;
   double keyframe_translation_m = 0.1;
   double keyframe_rotation_rad = 0.0872664626;  // 5 deg
 
