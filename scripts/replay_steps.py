@@ -8,7 +8,8 @@ local map is not rebuilt, so a rule that changes many steps is only approximated
 registered later scans against a different map. With --rule icp the replay is the ICP trajectory
 of `keyplace odometry --out`, and its errors are those `keyplace odometry --relations` prints.
 
-Usage: replay_steps.py STEPS.tsv [--relations FILE] [--rule RULE] [--local-dt S] [--out FILE]
+Usage: replay_steps.py STEPS.tsv [--relations FILE] [--rule RULE] [--local-dt S] [--tolerance S]
+                       [--out FILE]
 Rules:
   icp                  every step as ICP estimated it (the default)
   odometry             every step as the odometry measured it (raw odometry)
@@ -24,7 +25,6 @@ import bisect
 import math
 import os
 import sys
-import tempfile
 
 STEP_COLUMNS = 15
 CONVERGED = ("registered", "recovered")
@@ -50,24 +50,32 @@ def between(a, b):
     return (c * dx + s * dy, -s * dx + c * dy, wrap(b[2] - a[2]))
 
 
+def text_lines(path):
+    """The lines of a text file; InputError naming the file when it is not UTF-8 text."""
+    try:
+        with open(path, encoding="utf-8") as file:
+            return file.read().splitlines(keepends=True)
+    except UnicodeDecodeError as error:
+        raise InputError(f"{path}: not a text file (byte {error.start}: {error.reason})") from None
+
+
 def read_steps(path):
     steps = []
-    with open(path, encoding="utf-8") as lines:
-        for number, line in enumerate(lines, start=1):
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.rstrip("\n").split("\t")
-            if len(fields) != STEP_COLUMNS:
-                raise InputError(f"{path}:{number}: {len(fields)} columns, expected "
-                                 f"{STEP_COLUMNS} (keyplace odometry --steps)")
-            try:
-                icp = tuple(float(v) for v in fields[7:10])
-                odometry = tuple(float(v) for v in fields[10:13])
-                steps.append({"stamp": float(fields[1]), "status": fields[2],
-                              "inlier_ratio": float(fields[3]), "icp": icp,
-                              "odometry": None if math.isnan(odometry[0]) else odometry})
-            except ValueError as error:
-                raise InputError(f"{path}:{number}: {error}") from None
+    for number, line in enumerate(text_lines(path), start=1):
+        if line.startswith("#") or not line.strip():
+            continue
+        fields = line.rstrip("\n").split("\t")
+        if len(fields) != STEP_COLUMNS:
+            raise InputError(f"{path}:{number}: {len(fields)} columns, expected "
+                             f"{STEP_COLUMNS} (keyplace odometry --steps)")
+        try:
+            icp = tuple(float(v) for v in fields[7:10])
+            odometry = tuple(float(v) for v in fields[10:13])
+            steps.append({"stamp": float(fields[1]), "status": fields[2],
+                          "inlier_ratio": float(fields[3]), "icp": icp,
+                          "odometry": None if math.isnan(odometry[0]) else odometry})
+        except ValueError as error:
+            raise InputError(f"{path}:{number}: {error}") from None
     if not steps:
         raise InputError(f"{path}: no steps")
     return steps
@@ -114,48 +122,55 @@ def replay(steps, rule):
     return poses
 
 
-def relation_errors(steps, poses, path, local_dt_s, tolerance_s=1e-4):
+def relation_errors(steps, poses, path, local_dt_s, tolerance_s):
     order = sorted(range(len(steps)), key=lambda k: steps[k]["stamp"])
     stamps = [steps[k]["stamp"] for k in order]
 
     def nearest(stamp):
-        i = bisect.bisect_left(stamps, stamp - tolerance_s)
-        if i < len(stamps) and abs(stamps[i] - stamp) <= tolerance_s:
-            return order[i]
-        return None
+        # The scan with the nearest stamp within the tolerance; a tie goes to the earlier one.
+        i = bisect.bisect_left(stamps, stamp)
+        best = None
+        for j in (i - 1, i):
+            if 0 <= j < len(stamps) and abs(stamps[j] - stamp) <= tolerance_s:
+                if best is None or abs(stamps[j] - stamp) < abs(stamps[best] - stamp):
+                    best = j
+        return None if best is None else order[best]
 
     local, loop, relations = [], [], 0
-    with open(path, encoding="utf-8") as lines:
-        for number, line in enumerate(lines, start=1):
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            try:
-                if len(fields) < 8:
-                    raise ValueError
-                t_a, t_b, dx, dy = (float(v) for v in fields[:4])
-            except ValueError:
-                raise InputError(f"{path}:{number}: not a relation (t_a t_b x y z roll pitch "
-                                 "yaw)") from None
-            relations += 1
-            a, b = nearest(t_a), nearest(t_b)
-            if a is None or b is None:
-                continue
-            estimate = between(poses[a], poses[b])
-            error = math.hypot(estimate[0] - dx, estimate[1] - dy)
-            (local if abs(t_b - t_a) < local_dt_s else loop).append(error)
+    for number, line in enumerate(text_lines(path), start=1):
+        if line.lstrip().startswith("#") or not line.strip():
+            continue
+        fields = line.split()
+        try:
+            if len(fields) < 8:
+                raise ValueError
+            t_a, t_b, dx, dy = (float(v) for v in fields[:4])
+        except ValueError:
+            raise InputError(f"{path}:{number}: not a relation (t_a t_b x y z roll pitch "
+                             "yaw)") from None
+        relations += 1
+        a, b = nearest(t_a), nearest(t_b)
+        if a is None or b is None:
+            continue
+        estimate = between(poses[a], poses[b])
+        error = math.hypot(estimate[0] - dx, estimate[1] - dy)
+        (local if abs(t_b - t_a) < local_dt_s else loop).append(error)
     return relations, local, loop
 
 
 def write_poses(path, steps, poses):
-    # A temporary file renamed into place: an interrupted run leaves any earlier file whole.
-    directory = os.path.dirname(os.path.abspath(path))
-    with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=directory, delete=False,
-                                     prefix=".replay-", suffix=".tmp") as out:
-        out.write("# timestamp_s\tx_m\ty_m\ttheta_rad\n")
-        for step, pose in zip(steps, poses):
-            out.write(f"{step['stamp']:.6f}\t{pose[0]:.6f}\t{pose[1]:.6f}\t{pose[2]:.6f}\n")
-    os.replace(out.name, path)
+    # Written beside the target and renamed into place: an interrupted run leaves any earlier
+    # file whole.
+    temporary = f"{path}.tmp-{os.getpid()}"
+    try:
+        with open(temporary, "w", encoding="utf-8") as out:
+            out.write("# timestamp_s\tx_m\ty_m\ttheta_rad\n")
+            for step, pose in zip(steps, poses):
+                out.write(f"{step['stamp']:.6f}\t{pose[0]:.6f}\t{pose[1]:.6f}\t{pose[2]:.6f}\n")
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
 
 
 def mean(values):
@@ -163,24 +178,31 @@ def mean(values):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("steps")
-    parser.add_argument("--relations")
-    parser.add_argument("--rule", type=parse_rule, default=("icp", ()))
-    parser.add_argument("--local-dt", type=float, default=5.0)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("steps", help="the TSV of keyplace odometry --steps")
+    parser.add_argument("--relations", help="Kümmerle relation file to score the replay on")
+    parser.add_argument("--rule", type=parse_rule, default=("icp", ()),
+                        help="which step moves the robot (see above; default icp)")
+    parser.add_argument("--local-dt", type=float, default=5.0,
+                        help="relations shorter than this (s) are local (default 5)")
+    parser.add_argument("--tolerance", type=float, default=1e-4,
+                        help="a relation stamp matches the nearest scan stamp within this (s; "
+                             "default 1e-4, as evaluation.relation_stamp_tolerance_s)")
     parser.add_argument("--out", help="write the replayed poses (timestamp_s x_m y_m theta_rad)")
     options = parser.parse_args()
     try:
         steps = read_steps(options.steps)
         poses = replay(steps, options.rule)
         changed = sum(1 for step in steps[1:]
-                      if chosen_step(step, options.rule) != step["icp"])
+                      if max(abs(a - b) for a, b in zip(chosen_step(step, options.rule),
+                                                        step["icp"])) > 1e-12)
         print(f"replayed {len(steps)} scans; {changed} steps differ from ICP")
         if options.out:
             write_poses(options.out, steps, poses)
         if options.relations:
             relations, local, loop = relation_errors(steps, poses, options.relations,
-                                                     options.local_dt)
+                                                     options.local_dt, options.tolerance)
             matched = len(local) + len(loop)
             print(f"relations matched {matched} of {relations}: all {mean(local + loop):.4f} m, "
                   f"local {mean(local):.4f} m ({len(local)}), loop {mean(loop):.4f} m "

@@ -18,7 +18,7 @@ void PrintOdometryRun(const OdometryRun& run);
 /// The run statistics as flat keys (scans, scans_in_log, registered, ..., iterations_mean).
 nlohmann::json OdometryRunJson(const OdometryRun& run);
 
-/// "ICP vs odometry  median ... m, ... deg per step; 99 % ..." (or why there is no figure).
+/// "ICP vs odometry median ... m, ... deg per step; 99 % ..." (or why there is no figure).
 void PrintStepDisagreement(const OdometryStepDisagreement& summary);
 /// steps, median_m, p99_m, median_deg, p99_deg (null figures without steps).
 nlohmann::json StepDisagreementJson(const OdometryStepDisagreement& summary);

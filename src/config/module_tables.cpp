@@ -79,8 +79,8 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
                 "registered scan: skip points closer than this to the previous kept one")
         .Int("local_map_scans", &C::local_map_scans, "", "key scans in the local map")
         .Bool("sparse_normals_from_map", &C::sparse_normals_from_map,
-              "a map point its own scan is too sparse to fit a normal to gets one from the "
-              "whole local map")
+              "a map point its own scan gives no normal (too sparse there, or not line-like) "
+              "gets one fitted to the whole local map")
         .Double("keyframe_translation_m", &C::keyframe_translation_m, "m",
                 "a scan becomes a key scan after moving this far ...")
         .Double("keyframe_rotation_rad", &C::keyframe_rotation_rad, "rad",

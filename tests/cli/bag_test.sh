@@ -63,7 +63,17 @@ converged = [float(r[13]) for r in rows if r[2] in ('registered', 'recovered')]
 d = j['step_disagreement']
 assert d['steps'] == len(converged) > 250, (d, len(converged))
 assert abs(d['median_m'] - statistics.median(converged)) < 1e-5, (d, statistics.median(converged))
-assert all(float(r[13]) == 0 for r in rows if r[2].startswith('fallback')), 'fallback is odometry'
+# The disagreement columns are the ICP step seen from the odometry step (T_odo^-1 * T_icp).
+import math
+def between(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, math.atan2(math.sin(b[2] - a[2]), math.cos(b[2] - a[2])))
+for r in rows[1:]:
+    icp, odometry = [float(v) for v in r[7:10]], [float(v) for v in r[10:13]]
+    d = between(odometry, icp)
+    assert abs(math.hypot(d[0], d[1]) - float(r[13])) < 2e-5, r
+    assert abs(abs(math.degrees(d[2])) - float(r[14])) < 2e-3, r
 PY
 # Replaying the steps as ICP took them gives the ICP trajectory back (in its first pose's frame);
 # as the odometry measured them, another one.

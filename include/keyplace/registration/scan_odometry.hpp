@@ -37,8 +37,9 @@ struct ScanOdometryConfig {
   // robot therefore does not wash the map out with copies of one view.
   int local_map_scans = 10;
   // A key scan's point gets its normal from a line fitted within its own scan (no cross-scan
-  // noise). Where that scan is too sparse for a fit (beams further apart than
-  // icp.normal_max_neighbour_distance_m: beyond 8.6 m with 1 deg beams, 17 m with 0.5 deg),
+  // noise). Where that fails (fewer than two neighbours within
+  // icp.normal_max_neighbour_distance_m: a wall seen head-on beyond 17 m with 1 deg beams, 34 m
+  // with 0.5 deg, and much nearer at a grazing angle; or a neighbourhood that is not line-like),
   // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
   // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
   // default: better relation errors on every log, but one odometry glitch on Intel is no longer
