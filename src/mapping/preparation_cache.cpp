@@ -130,7 +130,8 @@ CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
                      std::to_string(reader.Left());
       return read;
     }
-    // The payload is the rest of the file but its checksum: kept in place, not copied.
+    // The payload is the rest of the file but its checksum: the file's buffer becomes the
+    // payload (header erased in place), no second buffer.
     bytes.resize(bytes.size() - 8);
     bytes.erase(0, body_begin + reader.at());
     read.payload = std::move(bytes);

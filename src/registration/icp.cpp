@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
@@ -128,6 +129,45 @@ struct IcpTarget::Impl {
 
 namespace {
 
+// The unit normal of the line fitted to point i's normal_neighbours nearest neighbours (those
+// within normal_max_neighbour_distance_m, at least 3 with the point itself), when the fit is
+// line-like (normal_max_eigenvalue_ratio); nullopt otherwise.
+std::optional<Eigen::Vector2d> FitNormal(const std::vector<Eigen::Vector2d>& points,
+                                         const KdTree& tree, std::size_t i,
+                                         const IcpConfig& config) {
+  const std::size_t k =
+      std::min<std::size_t>(static_cast<std::size_t>(config.normal_neighbours), points.size());
+  const double max_d2 =
+      config.normal_max_neighbour_distance_m * config.normal_max_neighbour_distance_m;
+  std::array<std::size_t, kMaxNormalNeighbours> indices{};
+  std::array<double, kMaxNormalNeighbours> d2{};
+  nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(k);
+  result.init(indices.data(), d2.data());
+  tree.findNeighbors(result, points[i].data(), nanoflann::SearchParams());
+  const std::size_t found = result.size();
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  int count = 0;
+  for (std::size_t j = 0; j < found; ++j) {
+    if (d2[j] > max_d2) continue;
+    mean += points[indices[j]];
+    ++count;
+  }
+  if (count < 3) return std::nullopt;
+  mean /= count;
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (std::size_t j = 0; j < found; ++j) {
+    if (d2[j] > max_d2) continue;
+    const Eigen::Vector2d d = points[indices[j]] - mean;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
+  eig.computeDirect(cov);
+  const double lmin = eig.eigenvalues()(0);
+  const double lmax = eig.eigenvalues()(1);
+  if (!(lmax > 0.0) || lmin > config.normal_max_eigenvalue_ratio * lmax) return std::nullopt;
+  return eig.eigenvectors().col(0).normalized();
+}
+
 PointNormals NormalsFromTree(const std::vector<Eigen::Vector2d>& points, const KdTree& tree,
                              const IcpConfig& config) {
   const std::size_t n = points.size();
@@ -135,39 +175,11 @@ PointNormals NormalsFromTree(const std::vector<Eigen::Vector2d>& points, const K
   out.normals.assign(n, Eigen::Vector2d::Zero());
   out.valid.assign(n, 0);
   if (n < 3) return out;
-  const std::size_t k =
-      std::min<std::size_t>(static_cast<std::size_t>(config.normal_neighbours), n);
-  const double max_d2 =
-      config.normal_max_neighbour_distance_m * config.normal_max_neighbour_distance_m;
-  std::array<std::size_t, kMaxNormalNeighbours> indices{};
-  std::array<double, kMaxNormalNeighbours> d2{};
   for (std::size_t i = 0; i < n; ++i) {
-    nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(k);
-    result.init(indices.data(), d2.data());
-    tree.findNeighbors(result, points[i].data(), nanoflann::SearchParams());
-    const std::size_t found = result.size();
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    int count = 0;
-    for (std::size_t j = 0; j < found; ++j) {
-      if (d2[j] > max_d2) continue;
-      mean += points[indices[j]];
-      ++count;
+    if (const std::optional<Eigen::Vector2d> normal = FitNormal(points, tree, i, config)) {
+      out.normals[i] = *normal;
+      out.valid[i] = 1;
     }
-    if (count < 3) continue;
-    mean /= count;
-    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-    for (std::size_t j = 0; j < found; ++j) {
-      if (d2[j] > max_d2) continue;
-      const Eigen::Vector2d d = points[indices[j]] - mean;
-      cov += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
-    eig.computeDirect(cov);
-    const double lmin = eig.eigenvalues()(0);
-    const double lmax = eig.eigenvalues()(1);
-    if (!(lmax > 0.0) || lmin > config.normal_max_eigenvalue_ratio * lmax) continue;
-    out.normals[i] = eig.eigenvectors().col(0).normalized();
-    out.valid[i] = 1;
   }
   return out;
 }
@@ -204,6 +216,22 @@ std::size_t IcpTarget::size() const { return impl_->points.size(); }
 const std::vector<Eigen::Vector2d>& IcpTarget::points() const { return impl_->points; }
 const Eigen::Vector2d& IcpTarget::normal(std::size_t i) const { return impl_->normals.normals[i]; }
 bool IcpTarget::HasNormal(std::size_t i) const { return impl_->normals.valid[i] != 0; }
+std::size_t IcpTarget::FillMissingNormals(const IcpConfig& config) {
+  ValidateIcpConfig(config);
+  const std::vector<Eigen::Vector2d>& points = impl_->points;
+  if (points.size() < 3) return 0;
+  std::size_t filled = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (impl_->normals.valid[i] != 0) continue;
+    if (const std::optional<Eigen::Vector2d> normal = FitNormal(points, impl_->tree, i, config)) {
+      impl_->normals.normals[i] = *normal;
+      impl_->normals.valid[i] = 1;
+      ++filled;
+    }
+  }
+  return filled;
+}
+
 std::size_t IcpTarget::CountNormals() const {
   return static_cast<std::size_t>(
       std::count(impl_->normals.valid.begin(), impl_->normals.valid.end(), std::uint8_t{1}));

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstddef>
-#include <cstdint>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -148,27 +146,6 @@ std::vector<Eigen::Vector2d> ScanOdometry::SubsampleBySpacing(
   return kept;
 }
 
-namespace {
-
-// Points whose own scan gave no normal get the one fitted to their neighbours in the whole map,
-// when there is one. The fit is done only when some point needs it.
-void FillNormalsFromMap(const std::vector<Eigen::Vector2d>& points, const IcpConfig& config,
-                        PointNormals& normals) {
-  if (std::all_of(normals.valid.begin(), normals.valid.end(),
-                  [](std::uint8_t valid) { return valid != 0; })) {
-    return;
-  }
-  const PointNormals from_map = EstimateNormals(points, config);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (normals.valid[i] == 0 && from_map.valid[i] != 0) {
-      normals.normals[i] = from_map.normals[i];
-      normals.valid[i] = 1;
-    }
-  }
-}
-
-}  // namespace
-
 void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
                                const Pose2& T_world_laser) {
   target_.reset();  // it refers to map_points_, which changes now
@@ -191,8 +168,8 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
     map_normals.valid.insert(map_normals.valid.end(), k.normals_world.valid.begin(),
                              k.normals_world.valid.end());
   }
-  if (config_.sparse_normals_from_map) FillNormalsFromMap(map_points_, config_.icp, map_normals);
   target_ = std::make_unique<IcpTarget>(map_points_, std::move(map_normals), config_.icp);
+  if (config_.sparse_normals_from_map) target_->FillMissingNormals(config_.icp);
   last_keyframe_T_world_laser_ = T_world_laser;
 }
 

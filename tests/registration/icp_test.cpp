@@ -297,6 +297,40 @@ TEST(IcpTest, NormalsArePerpendicularToWallsAndMissingAtCorners) {
   for (std::size_t i = 41; i < points.size(); ++i) EXPECT_FALSE(target.HasNormal(i));
 }
 
+TEST(IcpTest, MissingNormalsAreFittedOverAllTargetPointsOthersKept) {
+  // Two scans of a far wall y = 5, each with points 0.4 m apart (too sparse for a normal alone),
+  // the second shifted by 0.2 m: together 0.2 m apart. A near wall x = 0 carries given normals,
+  // deliberately tilted so that a refit would show.
+  std::vector<Eigen::Vector2d> points;
+  PointNormals normals;
+  for (int scan = 0; scan < 2; ++scan) {
+    for (int i = 0; i < 10; ++i) {
+      points.emplace_back(0.4 * i + 0.2 * scan, 5.0);
+      normals.normals.emplace_back(0.0, 0.0);
+      normals.valid.push_back(0);
+    }
+  }
+  const Eigen::Vector2d tilted = Eigen::Vector2d(1.0, 0.1).normalized();
+  for (int i = 0; i < 10; ++i) {
+    points.emplace_back(0.0, 0.05 * i);
+    normals.normals.push_back(tilted);
+    normals.valid.push_back(1);
+  }
+  IcpTarget target(points, normals, IcpConfig{});
+  EXPECT_EQ(target.CountNormals(), 10u);
+  // All but the wall's two ends (x = 0 and 3.8 m: one neighbour within 0.3 m) get one.
+  EXPECT_EQ(target.FillMissingNormals(IcpConfig{}), 18u);
+  EXPECT_EQ(target.CountNormals(), 28u);
+  EXPECT_FALSE(target.HasNormal(0));
+  EXPECT_FALSE(target.HasNormal(19));
+  for (std::size_t i = 1; i < 19; ++i) {
+    ASSERT_TRUE(target.HasNormal(i)) << i;
+    EXPECT_NEAR(std::abs(target.normal(i).y()), 1.0, 1e-9) << i;
+  }
+  for (std::size_t i = 20; i < 30; ++i) EXPECT_EQ(target.normal(i), tilted) << i;
+  EXPECT_EQ(target.FillMissingNormals(IcpConfig{}), 0u);
+}
+
 TEST(IcpTest, InvalidConfigThrowsNamingTheField) {
   const std::vector<Eigen::Vector2d> points = {{0, 0}, {1, 0}, {2, 0}};
   IcpConfig config;

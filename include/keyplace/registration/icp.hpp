@@ -132,6 +132,11 @@ class IcpTarget {
   const Eigen::Vector2d& normal(std::size_t i) const;
   bool HasNormal(std::size_t i) const;
   std::size_t CountNormals() const;
+  /// Fits a normal, as the first constructor does but over all the target's points, to each
+  /// point that has none (e.g. a far point its own scan was too sparse for, now among the points
+  /// of several scans). Points with a normal keep it. Returns how many got one; throws
+  /// std::invalid_argument for an invalid config.
+  std::size_t FillMissingNormals(const IcpConfig& config);
 
   /// Index of the nearest target point and its squared distance (m^2). Returns false when the
   /// target is empty.
