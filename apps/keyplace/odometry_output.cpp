@@ -45,7 +45,8 @@ void PrintOdometryRun(const OdometryRun& run) {
   fmt::print("scans           {} of {} ({} order)\n", s.scans, run.log_scans, ToString(run.order));
   fmt::print("registered      {}\n", s.registered);
   fmt::print(
-      "recovered       {} (ICP failed from the prediction, converged from a searched pose)\n",
+      "recovered       {} (the prediction was wrong: ICP converged from a searched pose, or the "
+      "odometry glitched)\n",
       s.recovered);
   fmt::print("fallbacks       {} not converged, {} correction too large, {} too few points\n",
              s.not_converged, s.fallback_correction_too_large, s.fallback_too_few_points);

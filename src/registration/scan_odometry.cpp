@@ -193,12 +193,27 @@ std::optional<IcpResult> ScanOdometry::Recover(const std::vector<Eigen::Vector2d
   if (!match.moved) return std::nullopt;  // ICP from the same start would fail the same way
   IcpResult icp = AlignPointToLine(*target_, source_laser, match.T_target_source, config_.icp);
   if (!icp.converged) return std::nullopt;
-  const Pose2 refinement = Between(match.T_target_source, icp.T_target_source);
-  if (TranslationNorm(refinement) > config_.max_correction_translation_m ||
-      std::abs(refinement.theta) > config_.max_correction_rotation_rad) {
+  if (!WithinCorrectionBounds(Between(match.T_target_source, icp.T_target_source))) {
     return std::nullopt;
   }
   return icp;
+}
+
+bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
+  return TranslationNorm(correction) <= config_.max_correction_translation_m &&
+         std::abs(correction.theta) <= config_.max_correction_rotation_rad;
+}
+
+// Two independent predictions of this scan's pose: the odometry's, and the previous step
+// repeated. When they part by more than the correction bound, one of them is wrong, and ICP,
+// which started from the odometry's and converged within the bound of the other, says which
+// (docs/REGISTRATION.md, "Odometry glitches").
+bool ScanOdometry::OdometryOverruledByMotion(const Pose2& predicted_T_world_laser,
+                                             const Pose2& icp_T_world_laser) const {
+  if (!have_previous_step_) return false;
+  const Pose2 motion_T_world_laser = previous_T_world_laser_ * previous_step_laser_;
+  return !WithinCorrectionBounds(Between(motion_T_world_laser, predicted_T_world_laser)) &&
+         WithinCorrectionBounds(Between(motion_T_world_laser, icp_T_world_laser));
 }
 
 ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
@@ -256,15 +271,15 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
         result.status = icp.status == IcpStatus::kTooFewPoints
                             ? ScanOdometryStatus::kFallbackTooFewPoints
                             : ScanOdometryStatus::kFallbackNotConverged;
+      } else if (WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source))) {
+        result.status = ScanOdometryStatus::kRegistered;
+        T_world_laser = icp.T_target_source;
+      } else if (config_.recovery_search && increment_measured &&
+                 OdometryOverruledByMotion(predicted_T_world_laser, icp.T_target_source)) {
+        result.status = ScanOdometryStatus::kRecovered;
+        T_world_laser = icp.T_target_source;
       } else {
-        const Pose2 correction = Between(predicted_T_world_laser, icp.T_target_source);
-        if (TranslationNorm(correction) > config_.max_correction_translation_m ||
-            std::abs(correction.theta) > config_.max_correction_rotation_rad) {
-          result.status = ScanOdometryStatus::kFallbackCorrectionTooLarge;
-        } else {
-          result.status = ScanOdometryStatus::kRegistered;
-          T_world_laser = icp.T_target_source;
-        }
+        result.status = ScanOdometryStatus::kFallbackCorrectionTooLarge;
       }
       if (config_.recovery_search &&
           (result.status == ScanOdometryStatus::kFallbackNotConverged ||
@@ -289,6 +304,10 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       result.keyframe = true;
       AddKeyframe(points, T_world_laser);
     }
+  }
+  if (num_scans_ > 0) {
+    previous_step_laser_ = Between(previous_T_world_laser_, result.T_world_laser);
+    have_previous_step_ = true;
   }
   previous_T_world_laser_ = result.T_world_laser;
   ++num_scans_;

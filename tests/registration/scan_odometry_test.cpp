@@ -391,6 +391,57 @@ TEST(ScanOdometryTest, FastTurnWithSlippingWheelsIsRecovered) {
   EXPECT_GE(recovered, 1);
 }
 
+// The robot drives straight at 0.1 m per scan; once, the odometry jumps 0.7 m ahead and 8 deg
+// (a stale reading caught up, a wheel spun) and then reports steps right again. Returns the
+// glitched scan's result and the position error (m) at the end of the run.
+struct GlitchRun {
+  ScanOdometryResult glitched;
+  double end_error_m = 0.0;
+};
+
+GlitchRun DriveThroughAnOdometryGlitch(const ScanOdometryConfig& config) {
+  const auto world = testing::IrregularRoom();
+  ScanOptions options;
+  options.beams = 361;
+  options.fov_rad = M_PI;
+  options.range_noise_m = 0.01;
+  std::mt19937 rng(8);
+  constexpr int kSteps = 14;
+  constexpr int kGlitchStep = 8;
+  Pose2 truth(-2.2, -0.8, DegToRad(10.0));
+  Pose2 odometry_pose = truth;
+  ScanOdometry odometry(config);
+  GlitchRun run;
+  for (int i = 0; i <= kSteps; ++i) {
+    if (i > 0) {
+      truth = truth * Pose2(0.1, 0.0, 0.0);
+      odometry_pose = odometry_pose *
+                      (i == kGlitchStep ? Pose2(0.8, 0.0, DegToRad(8.0)) : Pose2(0.1, 0.0, 0.0));
+    }
+    LogScan scan;
+    static_cast<LaserScan&>(scan) = CastScan(world, truth, options, &rng);
+    const ScanOdometryResult result = odometry.Add(scan, odometry_pose);
+    if (i == kGlitchStep) run.glitched = result;
+    run.end_error_m = TranslationNorm(Between(truth, result.T_world_robot));
+  }
+  return run;
+}
+
+TEST(ScanOdometryTest, OdometryGlitchBeyondTheCorrectionBoundIsOverruledByTheMotion) {
+  const GlitchRun run = DriveThroughAnOdometryGlitch(ScanOdometryConfig{});
+  // ICP from the glitched prediction converges 0.7 m from it, beyond the 0.5 m bound, but where
+  // the previous step repeated puts the robot: the odometry is the one that is wrong.
+  EXPECT_EQ(run.glitched.status, ScanOdometryStatus::kRecovered);
+  EXPECT_EQ(run.glitched.icp_status, IcpStatus::kConverged);
+  EXPECT_LT(run.end_error_m, 0.05);
+  // Without recovery the glitch is taken as it is and stays in the trajectory.
+  ScanOdometryConfig no_recovery;
+  no_recovery.recovery_search = false;
+  const GlitchRun kept = DriveThroughAnOdometryGlitch(no_recovery);
+  EXPECT_EQ(kept.glitched.status, ScanOdometryStatus::kFallbackCorrectionTooLarge);
+  EXPECT_GT(kept.end_error_m, 0.5);
+}
+
 TEST(ScanOdometryTest, RecoveryConfigIsValidated) {
   ScanOdometryConfig config;
   config.recovery_step_translation_m = 0.0;

@@ -42,8 +42,8 @@ struct ScanOdometryConfig {
   // with 0.5 deg, and much nearer at a grazing angle; or a neighbourhood that is not line-like),
   // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
   // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
-  // default: better relation errors on every log, but one odometry glitch on Intel is no longer
-  // absorbed (docs/REGISTRATION.md, "Normals from the local map").
+  // default: better relation errors on every log, but a worse SLAM ATE on both development logs
+  // (docs/REGISTRATION.md, "Normals from the local map").
   bool sparse_normals_from_map = false;
   double keyframe_translation_m = 0.1;
   double keyframe_rotation_rad = 0.0872664626;  // 5 deg
@@ -60,7 +60,10 @@ struct ScanOdometryConfig {
   // recovery_step_translation_m, rotations ±recovery_window_rotation_rad in steps of
   // recovery_step_rotation_rad) and ICP runs again from the best one. Its result is used when it
   // converges within the max_correction_* bounds of that pose (status kRecovered); otherwise the
-  // scan falls back to odometry as before. false: fall back at once.
+  // scan falls back to odometry as before. Before the search, an ICP result beyond the bounds is
+  // taken (kRecovered) when the odometry's prediction and the previous step repeated part by
+  // more than the bounds and the result lies within them of the latter: the odometry glitched.
+  // false: fall back at once.
   bool recovery_search = true;
   double recovery_window_translation_m = 0.5;
   double recovery_window_rotation_rad = 0.7853981634;  // 45 deg
@@ -91,9 +94,11 @@ struct ScanOdometryConfig {
 void ValidateScanOdometryConfig(const ScanOdometryConfig& config);
 
 enum class ScanOdometryStatus {
-  kFirstScan,                   // defines the world frame (= odometry frame at the first scan)
-  kRegistered,                  // ICP converged and was accepted
-  kRecovered,                   // ICP failed from the prediction, converged from a searched pose
+  kFirstScan,   // defines the world frame (= odometry frame at the first scan)
+  kRegistered,  // ICP converged and was accepted
+  // ICP failed from the prediction and converged from a searched pose, or converged beyond the
+  // bounds where the previous step repeated says that the odometry glitched
+  kRecovered,
   kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
   kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
   kFallbackTooFewPoints,        // scan or map too small for ICP: odometry used
@@ -149,6 +154,11 @@ class ScanOdometry {
   /// close to that pose.
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
+  bool WithinCorrectionBounds(const Pose2& correction) const;
+  /// True when the odometry's prediction and the previous step repeated part by more than the
+  /// correction bound and ICP, started from the odometry's, converged within it of the other.
+  bool OdometryOverruledByMotion(const Pose2& predicted_T_world_laser,
+                                 const Pose2& icp_T_world_laser) const;
 
   ScanOdometryConfig config_;
   std::size_t num_scans_ = 0;
@@ -157,6 +167,8 @@ class ScanOdometry {
   bool previous_scan_had_odometry_ = false;
   Pose2 previous_odometry_laser_;  // T_odom_laser of the previous scan
   Pose2 previous_T_world_laser_;
+  Pose2 previous_step_laser_;  // the previous scan's estimated step, in its predecessor's frame
+  bool have_previous_step_ = false;
   Pose2 last_keyframe_T_world_laser_;
   struct Keyframe {
     std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
