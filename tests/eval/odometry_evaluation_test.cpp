@@ -34,10 +34,7 @@ double IpcStamp(int step) { return 50.0 + 0.1 * step + (step % 3 == 0 ? 0.25 : 0
 
 Drive MakeDrive(int steps, bool drifting) {
   const auto world = testing::IrregularRoom();
-  testing::ScanOptions options;
-  options.beams = 180;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.005;
+  testing::ScanOptions options = testing::FrontLaser(180, 0.005);
   std::mt19937 rng(11);
   const Pose2 step(0.1, 0.0, DegToRad(4.5));
   std::vector<Pose2> truth;

@@ -51,10 +51,7 @@ TEST(ProximityField, ClosenessFallsWithDistanceAndVanishesBeyondThreeSigma) {
 // basin of ICP.
 TEST(CorrelativeSearch, FindsTheTruePoseFarFromTheGuess) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options;
-  options.beams = 360;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.01;
+  ScanOptions options = testing::FrontLaser(360, 0.01);
   std::mt19937 rng(3);
   const Pose2 T_world_map_laser(-1.0, -1.0, DegToRad(20.0));
   const Pose2 T_world_laser(-0.8, -1.1, DegToRad(55.0));

@@ -53,10 +53,7 @@ Drive MakeDrive(const std::vector<testing::Segment>& world, int steps, const Pos
 
 TEST(ScanOdometryTest, CorrectsDriftingOdometryInARoom) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options;
-  options.beams = 180;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.01;
+  ScanOptions options = testing::FrontLaser(180, 0.01);
   const Pose2 T_robot_laser(-0.04, 0.0, 0.0);
   // A circle of radius ~1.3 m around (0.5, 0.2): 60 steps of 0.1 m / 4.5 deg.
   const Drive drive = MakeDrive(world, 60, Pose2(0.1, 0.0, DegToRad(4.5)), Pose2(0.5, -1.1, 0.0),
@@ -92,10 +89,7 @@ TEST(ScanOdometryTest, CorrectsDriftingOdometryInARoom) {
 // sigmas let the room's walls correct the drift, and without odometry there is no prior to keep.
 TEST(ScanOdometryTest, OdometryPriorWeighsTheOdometryAgainstTheScans) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options;
-  options.beams = 180;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.01;
+  ScanOptions options = testing::FrontLaser(180, 0.01);
   const Drive drive = MakeDrive(world, 30, Pose2(0.1, 0.0, DegToRad(4.5)), Pose2(0.5, -1.1, 0.0),
                                 Pose2(), options, 5);
   struct Run {
@@ -172,11 +166,8 @@ TEST(ScanOdometryTest, OdometryPriorConfigIsValidated) {
 
 TEST(ScanOdometryTest, CorridorDoesNotSlideAwayFromOdometry) {
   const auto world = testing::Corridor(1.0);
-  ScanOptions options;
-  options.beams = 360;
-  options.fov_rad = M_PI;
+  ScanOptions options = testing::FrontLaser(360, 0.01);
   options.max_range_m = 10.0;
-  options.range_noise_m = 0.01;
   // 40 steps of 0.1 m along the corridor; the odometry says 0.105 m per step and turns a bit.
   const Drive drive =
       MakeDrive(world, 40, Pose2(0.1, 0.0, 0.0), Pose2(0.0, 0.0, 0.0), Pose2(), options, 9);
@@ -213,11 +204,8 @@ SparseEndWallRun DriveTowardsASparseEndWall(bool sparse_normals_from_map) {
                                                {{-2.0, 2.5}, {22.0, 2.5}},
                                                {{22.0, -2.5}, {22.0, 2.5}},
                                                {{-2.0, -2.5}, {-2.0, 2.5}}};
-  ScanOptions options;
-  options.beams = 180;
-  options.fov_rad = M_PI;
+  ScanOptions options = testing::FrontLaser(180, 0.005);
   options.max_range_m = 25.0;
-  options.range_noise_m = 0.005;
   ScanOdometryConfig config;
   config.sparse_normals_from_map = sparse_normals_from_map;
   ScanOdometry odometry(config);
@@ -342,10 +330,7 @@ namespace {
 // heading error (deg) at the end of the run, and counts the recovered scans.
 double HeadingErrorAfterFastTurnDeg(const ScanOdometryConfig& config, int* recovered) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options;
-  options.beams = 181;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.01;
+  ScanOptions options = testing::FrontLaser(181, 0.01);
   std::mt19937 rng(21);
   std::vector<Pose2> truth_steps;
   std::vector<Pose2> odometry_steps;
@@ -401,10 +386,7 @@ struct GlitchRun {
 
 GlitchRun DriveThroughAnOdometryGlitch(const ScanOdometryConfig& config) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options;
-  options.beams = 361;
-  options.fov_rad = M_PI;
-  options.range_noise_m = 0.01;
+  ScanOptions options = testing::FrontLaser(361, 0.01);
   std::mt19937 rng(8);
   constexpr int kSteps = 14;
   constexpr int kGlitchStep = 8;

@@ -53,6 +53,15 @@ struct ScanOptions {
   double outlier_fraction = 0.0;  // beams replaced by a random shorter range
 };
 
+/// A front laser: `beams` beams over -90..+90 deg with Gaussian range noise.
+inline ScanOptions FrontLaser(int beams, double range_noise_m) {
+  ScanOptions options;
+  options.beams = beams;
+  options.fov_rad = M_PI;
+  options.range_noise_m = range_noise_m;
+  return options;
+}
+
 /// Ray-casts `world` from the laser pose T_world_laser.
 inline LaserScan CastScan(const std::vector<Segment>& world, const Pose2& T_world_laser,
                           const ScanOptions& options, std::mt19937* rng = nullptr) {

@@ -51,11 +51,8 @@ std::vector<Segment> Hall() {
 // Its cloud is in the frame of its first pose.
 SubmapCloud CastSubmap(const std::vector<Segment>& world, const Pose2& origin, int scans,
                        std::mt19937* rng, const LoopRefinementConfig& config) {
-  ScanOptions options;
-  options.beams = 361;
-  options.fov_rad = M_PI;
+  ScanOptions options = testing::FrontLaser(361, 0.01);
   options.max_range_m = 8.0;
-  options.range_noise_m = 0.01;
   std::vector<std::vector<Eigen::Vector2d>> points;
   std::vector<Pose2> T_submap_laser;
   for (int k = 0; k < scans; ++k) {
