@@ -86,11 +86,14 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
         .Double("keyframe_rotation_rad", &C::keyframe_rotation_rad, "rad",
                 "... or turning this much")
         .Double("max_correction_translation_m", &C::max_correction_translation_m, "m",
-                "ICP results further than this from the odometry prediction are rejected ...")
+                "ICP results further than this from the odometry prediction are rejected (unless "
+                "recovered) ...")
         .Double("max_correction_rotation_rad", &C::max_correction_rotation_rad, "rad",
                 "... or turned more than this")
         .Bool("recovery_search", &C::recovery_search,
-              "a failed or rejected ICP retries from the best pose of a correlative search")
+              "a failed or rejected ICP retries from the best pose of a correlative search; a "
+              "rejected one "
+              "is taken when the previous step repeated confirms it against the odometry")
         .Double("recovery_window_translation_m", &C::recovery_window_translation_m, "m",
                 "the search covers this much translation around the prediction ...")
         .Double("recovery_window_rotation_rad", &C::recovery_window_rotation_rad, "rad",

@@ -204,13 +204,13 @@ bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
          std::abs(correction.theta) <= config_.max_correction_rotation_rad;
 }
 
-// Two independent predictions of this scan's pose: the odometry's, and the previous step
-// repeated. When they part by more than the correction bound, one of them is wrong, and ICP,
-// which started from the odometry's and converged within the bound of the other, says which
-// (docs/REGISTRATION.md, "Odometry glitches").
-bool ScanOdometry::OdometryOverruledByMotion(const Pose2& predicted_T_world_laser,
-                                             const Pose2& icp_T_world_laser) const {
-  if (!have_previous_step_) return false;
+// Two independent predictions of this scan's pose: the odometry's, and the previous step as ICP
+// estimated it, repeated. When they part by more than the correction bound, one of them is wrong,
+// and ICP, which started from the odometry's and converged within the bound of the other, says
+// which (docs/REGISTRATION.md, "Odometry glitches").
+bool ScanOdometry::ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
+                                                     const Pose2& icp_T_world_laser) const {
+  if (!have_previous_icp_step_) return false;
   const Pose2 motion_T_world_laser = previous_T_world_laser_ * previous_step_laser_;
   return !WithinCorrectionBounds(Between(motion_T_world_laser, predicted_T_world_laser)) &&
          WithinCorrectionBounds(Between(motion_T_world_laser, icp_T_world_laser));
@@ -275,7 +275,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
         result.status = ScanOdometryStatus::kRegistered;
         T_world_laser = icp.T_target_source;
       } else if (config_.recovery_search && increment_measured &&
-                 OdometryOverruledByMotion(predicted_T_world_laser, icp.T_target_source)) {
+                 ConstantVelocityOverrulesOdometry(predicted_T_world_laser, icp.T_target_source)) {
         result.status = ScanOdometryStatus::kRecovered;
         T_world_laser = icp.T_target_source;
       } else {
@@ -305,9 +305,10 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       AddKeyframe(points, T_world_laser);
     }
   }
-  if (num_scans_ > 0) {
+  // A fallback's step is the odometry's own, no second opinion on the next one.
+  have_previous_icp_step_ = num_scans_ > 0 && result.converged;
+  if (have_previous_icp_step_) {
     previous_step_laser_ = Between(previous_T_world_laser_, result.T_world_laser);
-    have_previous_step_ = true;
   }
   previous_T_world_laser_ = result.T_world_laser;
   ++num_scans_;

@@ -376,52 +376,82 @@ TEST(ScanOdometryTest, FastTurnWithSlippingWheelsIsRecovered) {
   EXPECT_GE(recovered, 1);
 }
 
-// The robot drives straight at 0.1 m per scan; once, the odometry jumps 0.7 m ahead and 8 deg
-// (a stale reading caught up, a wheel spun) and then reports steps right again. Returns the
-// glitched scan's result and the position error (m) at the end of the run.
-struct GlitchRun {
-  ScanOdometryResult glitched;
-  double end_error_m = 0.0;
+// The robot drives straight through the room; once, the odometry reports a step too long (a
+// stale reading caught up, a wheel spun) and then reports steps right again.
+struct GlitchDrive {
+  double step_m = 0.1;
+  double heading_deg = 10.0;  // at the start, in the world
+  Pose2 glitch_extra;         // added to the glitched step
+  ScanOdometryConfig config;
 };
 
-GlitchRun DriveThroughAnOdometryGlitch(const ScanOdometryConfig& config) {
+struct GlitchRun {
+  ScanOdometryResult glitched;
+  double glitched_error_m = 0.0;  // position error of the glitched scan
+  double end_error_m = 0.0;       // and of the last scan
+};
+
+GlitchRun DriveThroughAnOdometryGlitch(const GlitchDrive& drive) {
   const auto world = testing::IrregularRoom();
-  ScanOptions options = testing::FrontLaser(361, 0.01);
+  const ScanOptions options = testing::FrontLaser(361, 0.01);
   std::mt19937 rng(8);
   constexpr int kSteps = 14;
   constexpr int kGlitchStep = 8;
-  Pose2 truth(-2.2, -0.8, DegToRad(10.0));
+  const Pose2 step(drive.step_m, 0.0, 0.0);
+  Pose2 truth(-2.2, -1.5, DegToRad(drive.heading_deg));
   Pose2 odometry_pose = truth;
-  ScanOdometry odometry(config);
+  ScanOdometry odometry(drive.config);
   GlitchRun run;
   for (int i = 0; i <= kSteps; ++i) {
     if (i > 0) {
-      truth = truth * Pose2(0.1, 0.0, 0.0);
-      odometry_pose = odometry_pose *
-                      (i == kGlitchStep ? Pose2(0.8, 0.0, DegToRad(8.0)) : Pose2(0.1, 0.0, 0.0));
+      truth = truth * step;
+      odometry_pose = odometry_pose * (i == kGlitchStep ? step * drive.glitch_extra : step);
     }
     LogScan scan;
     static_cast<LaserScan&>(scan) = CastScan(world, truth, options, &rng);
     const ScanOdometryResult result = odometry.Add(scan, odometry_pose);
-    if (i == kGlitchStep) run.glitched = result;
-    run.end_error_m = TranslationNorm(Between(truth, result.T_world_robot));
+    const double error_m = TranslationNorm(Between(truth, result.T_world_robot));
+    if (i == kGlitchStep) {
+      run.glitched = result;
+      run.glitched_error_m = error_m;
+    }
+    run.end_error_m = error_m;
   }
   return run;
 }
 
 TEST(ScanOdometryTest, OdometryGlitchBeyondTheCorrectionBoundIsOverruledByTheMotion) {
-  const GlitchRun run = DriveThroughAnOdometryGlitch(ScanOdometryConfig{});
+  GlitchDrive drive;
+  drive.glitch_extra = Pose2(0.7, 0.0, DegToRad(8.0));
+  const GlitchRun run = DriveThroughAnOdometryGlitch(drive);
   // ICP from the glitched prediction converges 0.7 m from it, beyond the 0.5 m bound, but where
   // the previous step repeated puts the robot: the odometry is the one that is wrong.
   EXPECT_EQ(run.glitched.status, ScanOdometryStatus::kRecovered);
   EXPECT_EQ(run.glitched.icp_status, IcpStatus::kConverged);
+  EXPECT_LT(run.glitched_error_m, 0.05);
   EXPECT_LT(run.end_error_m, 0.05);
   // Without recovery the glitch is taken as it is and stays in the trajectory.
-  ScanOdometryConfig no_recovery;
-  no_recovery.recovery_search = false;
-  const GlitchRun kept = DriveThroughAnOdometryGlitch(no_recovery);
+  drive.config.recovery_search = false;
+  const GlitchRun kept = DriveThroughAnOdometryGlitch(drive);
   EXPECT_EQ(kept.glitched.status, ScanOdometryStatus::kFallbackCorrectionTooLarge);
-  EXPECT_GT(kept.end_error_m, 0.5);
+  EXPECT_GT(kept.end_error_m, 0.5);  // 0.70 m
+}
+
+// Steps longer than the correction bound, at 60 deg to the world's axes: only the previous step
+// repeated in the robot's own frame lies within the bound of the truth (no motion, or the step
+// taken along the world's x axis, would miss it by 0.2 m). The search window is too small to
+// reach the truth from the glitched prediction, so nothing else can take the scan.
+TEST(ScanOdometryTest, GlitchIsJudgedByThePreviousStepInTheRobotFrame) {
+  GlitchDrive drive;
+  drive.step_m = 0.2;
+  drive.heading_deg = 60.0;
+  drive.glitch_extra = Pose2(0.4, 0.0, 0.0);
+  drive.config.max_correction_translation_m = 0.15;
+  drive.config.recovery_window_translation_m = 0.1;
+  const GlitchRun run = DriveThroughAnOdometryGlitch(drive);
+  EXPECT_EQ(run.glitched.status, ScanOdometryStatus::kRecovered);
+  EXPECT_LT(run.glitched_error_m, 0.05);
+  EXPECT_LT(run.end_error_m, 0.05);
 }
 
 TEST(ScanOdometryTest, RecoveryConfigIsValidated) {

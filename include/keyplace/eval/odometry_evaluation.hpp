@@ -42,7 +42,7 @@ struct OdometryRunOptions {
 struct OdometryRunStats {
   std::size_t scans = 0;          // scans registered (the range of the processing order)
   std::size_t registered = 0;     // ScanOdometryStatus::kRegistered
-  std::size_t recovered = 0;      // kRecovered (ICP from a searched pose)
+  std::size_t recovered = 0;      // kRecovered (searched pose, or odometry glitch)
   std::size_t not_converged = 0;  // kFallbackNotConverged
   std::size_t fallback_correction_too_large = 0;  // kFallbackCorrectionTooLarge
   std::size_t fallback_too_few_points = 0;        // kFallbackTooFewPoints

@@ -42,14 +42,16 @@ struct ScanOdometryConfig {
   // with 0.5 deg, and much nearer at a grazing angle; or a neighbourhood that is not line-like),
   // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
   // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
-  // default: better relation errors on every log, but a worse SLAM ATE on both development logs
+  // default: better local relation errors on every log with relations, but a worse SLAM ATE on
+  // both development logs
   // (docs/REGISTRATION.md, "Normals from the local map").
   bool sparse_normals_from_map = false;
   double keyframe_translation_m = 0.1;
   double keyframe_rotation_rad = 0.0872664626;  // 5 deg
 
   // An ICP result that moves the pose further than this from the odometry-predicted pose is
-  // rejected (fallback to odometry, flagged). Guards against converging into a wrong minimum.
+  // rejected (fallback to odometry, flagged) unless recovery_search recovers the scan. Guards
+  // against converging into a wrong minimum.
   double max_correction_translation_m = 0.5;
   double max_correction_rotation_rad = 0.3490658504;  // 20 deg
 
@@ -61,8 +63,9 @@ struct ScanOdometryConfig {
   // recovery_step_rotation_rad) and ICP runs again from the best one. Its result is used when it
   // converges within the max_correction_* bounds of that pose (status kRecovered); otherwise the
   // scan falls back to odometry as before. Before the search, an ICP result beyond the bounds is
-  // taken (kRecovered) when the odometry's prediction and the previous step repeated part by
-  // more than the bounds and the result lies within them of the latter: the odometry glitched.
+  // taken (kRecovered) when the odometry's prediction and the previous ICP step repeated part by
+  // more than the bounds and the result lies within them of the latter: the odometry glitched
+  // (only with odometry at this scan and the one before).
   // false: fall back at once.
   bool recovery_search = true;
   double recovery_window_translation_m = 0.5;
@@ -155,10 +158,11 @@ class ScanOdometry {
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
   bool WithinCorrectionBounds(const Pose2& correction) const;
-  /// True when the odometry's prediction and the previous step repeated part by more than the
-  /// correction bound and ICP, started from the odometry's, converged within it of the other.
-  bool OdometryOverruledByMotion(const Pose2& predicted_T_world_laser,
-                                 const Pose2& icp_T_world_laser) const;
+  /// True when the odometry's prediction and the previous ICP step repeated (constant velocity)
+  /// part by more than the correction bounds, and ICP, started from the odometry's prediction,
+  /// converged within those bounds of the constant-velocity one.
+  bool ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
+                                         const Pose2& icp_T_world_laser) const;
 
   ScanOdometryConfig config_;
   std::size_t num_scans_ = 0;
@@ -167,8 +171,10 @@ class ScanOdometry {
   bool previous_scan_had_odometry_ = false;
   Pose2 previous_odometry_laser_;  // T_odom_laser of the previous scan
   Pose2 previous_T_world_laser_;
-  Pose2 previous_step_laser_;  // the previous scan's estimated step, in its predecessor's frame
-  bool have_previous_step_ = false;
+  // The previous scan's step as ICP estimated it, in its predecessor's laser frame; only when
+  // that scan converged (a fallback's step is the odometry's own).
+  Pose2 previous_step_laser_;
+  bool have_previous_icp_step_ = false;
   Pose2 last_keyframe_T_world_laser_;
   struct Keyframe {
     std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
