@@ -92,8 +92,8 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
                 "... or turned more than this")
         .Bool("recovery_search", &C::recovery_search,
               "a failed or rejected ICP retries from the best pose of a correlative search; a "
-              "rejected one "
-              "is taken when the previous step repeated confirms it against the odometry")
+              "rejected one is taken when the previous step repeated confirms it against the "
+              "odometry")
         .Double("recovery_window_translation_m", &C::recovery_window_translation_m, "m",
                 "the search covers this much translation around the prediction ...")
         .Double("recovery_window_rotation_rad", &C::recovery_window_rotation_rad, "rad",

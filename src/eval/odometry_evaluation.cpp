@@ -166,9 +166,7 @@ OdometryStepDisagreement SummarizeStepDisagreement(const std::vector<OdometrySte
   std::vector<double> translation_m;
   std::vector<double> rotation_rad;
   for (const OdometryStep& step : steps) {
-    const bool converged = step.status == ScanOdometryStatus::kRegistered ||
-                           step.status == ScanOdometryStatus::kRecovered;
-    if (!converged || !step.T_previous_current_odometry) continue;
+    if (!IsIcpPose(step.status) || !step.T_previous_current_odometry) continue;
     translation_m.push_back(step.disagreement_m);
     rotation_rad.push_back(step.disagreement_rad);
   }

@@ -65,6 +65,10 @@ std::string ToString(ScanOdometryStatus status) {
   return "unknown";
 }
 
+bool IsIcpPose(ScanOdometryStatus status) {
+  return status == ScanOdometryStatus::kRegistered || status == ScanOdometryStatus::kRecovered;
+}
+
 void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
   try {
     ValidateIcpConfig(c.icp);
@@ -291,8 +295,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
         }
       }
     }
-    result.converged = result.status == ScanOdometryStatus::kRegistered ||
-                       result.status == ScanOdometryStatus::kRecovered;
+    result.converged = IsIcpPose(result.status);
     result.fell_back = !result.converged;
     result.T_world_laser = T_world_laser;
     result.T_world_robot = T_world_laser * T_robot_laser.inverse();

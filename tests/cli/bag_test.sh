@@ -54,8 +54,11 @@ check "odometry bag" "$keyplace" odometry "$bag" --scans 0:300 --steps "$work/st
   --json "$work/odo.json" --out "$work/icp.tsv"
 grep -qE '^ICP vs odometry median [0-9.]+ m, [0-9.]+ deg per step' "$work/out" && ok ||
   fail "odometry prints how far ICP and odometry part"
-/usr/bin/python3 - "$work/odo.json" "$work/steps.tsv" <<'PY' && ok || fail "odometry --steps"
-import json, statistics, sys
+/usr/bin/python3 - "$work/odo.json" "$work/steps.tsv" "$source_dir/scripts" <<'PY' && ok ||
+  fail "odometry --steps"
+import json, math, statistics, sys
+sys.path.insert(0, sys.argv[3])
+from replay_steps import between
 j = json.load(open(sys.argv[1]))
 rows = [l.rstrip('\n').split('\t') for l in open(sys.argv[2]) if not l.startswith('#')]
 assert len(rows) == 300 and rows[0][2] == 'first_scan', len(rows)
@@ -64,11 +67,6 @@ d = j['step_disagreement']
 assert d['steps'] == len(converged) > 250, (d, len(converged))
 assert abs(d['median_m'] - statistics.median(converged)) < 1e-5, (d, statistics.median(converged))
 # The disagreement columns are the ICP step seen from the odometry step (T_odo^-1 * T_icp).
-import math
-def between(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return (c * dx + s * dy, -s * dx + c * dy, math.atan2(math.sin(b[2] - a[2]), math.cos(b[2] - a[2])))
 for r in rows[1:]:
     icp, odometry = [float(v) for v in r[7:10]], [float(v) for v in r[10:13]]
     d = between(odometry, icp)

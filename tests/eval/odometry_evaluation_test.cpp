@@ -241,9 +241,9 @@ TEST(OdometryEvaluationTest, StepsSetTheIcpStepBesideTheOdometryStepItCorrected)
   // The 99th percentile of ~27 values lies between the two largest counted disagreements.
   std::vector<double> counted_rad;
   for (const OdometryStep& step : steps) {
-    const bool converged = step.status == ScanOdometryStatus::kRegistered ||
-                           step.status == ScanOdometryStatus::kRecovered;
-    if (converged && step.T_previous_current_odometry) counted_rad.push_back(step.disagreement_rad);
+    if (IsIcpPose(step.status) && step.T_previous_current_odometry) {
+      counted_rad.push_back(step.disagreement_rad);
+    }
   }
   ASSERT_EQ(counted_rad.size(), summary.steps);
   std::sort(counted_rad.begin(), counted_rad.end());

@@ -43,8 +43,7 @@ struct ScanOdometryConfig {
   // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
   // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
   // default: better local relation errors on every log with relations, but a worse SLAM ATE on
-  // both development logs
-  // (docs/REGISTRATION.md, "Normals from the local map").
+  // both development logs (docs/REGISTRATION.md, "Normals from the local map").
   bool sparse_normals_from_map = false;
   double keyframe_translation_m = 0.1;
   double keyframe_rotation_rad = 0.0872664626;  // 5 deg
@@ -108,6 +107,8 @@ enum class ScanOdometryStatus {
 };
 
 std::string ToString(ScanOdometryStatus status);
+/// True for kRegistered and kRecovered: the pose is ICP's, not the odometry's.
+bool IsIcpPose(ScanOdometryStatus status);
 
 struct ScanOdometryResult {
   std::size_t sequence = 0;  // 0-based order in which the scan was added
