@@ -17,8 +17,12 @@ PyConfig MakeConfig(const std::string& preset, const py::object& overrides,
   PyConfig config;
   config.preset = preset;
   config.config = PresetConfig(preset);
-  if (!file.is_none()) ApplyConfigFile(py::str(file).cast<std::string>(), config.config);
-  return ResolveConfig(py::cast(config), overrides);
+  // The file and the overrides validated together, once (as --config and --set).
+  ConfigBuilder builder(config.config);
+  if (!file.is_none()) builder.File(py::str(file).cast<std::string>());
+  AddOverrides(overrides, builder);
+  config.config = builder.Build();
+  return config;
 }
 
 std::string Get(const PyConfig& config, const std::string& key) {
@@ -38,8 +42,9 @@ void BindConfig(py::module_& module) {
       .def(py::init(&MakeConfig), py::arg("preset") = "default", py::arg("overrides") = py::none(),
            py::arg("file") = py::none(),
            "Config(preset='default', overrides=None, file=None): the preset ('default', 'paper' "
-           "or 'strict'), then the YAML file, then overrides {'section.key': value} (as --set). "
-           "Raises ValueError naming the key for an unknown key or an invalid value.")
+           "or 'strict'), then the YAML file, then overrides {'section.key': value} (as --set), "
+           "validated once after all of them. Raises ValueError naming the key for an unknown "
+           "key or an invalid value.")
       .def_readonly("preset", &PyConfig::preset, "The preset the configuration started from.")
       .def(
           "set",

@@ -44,6 +44,8 @@ struct PyConfig {
 /// The configuration a function was given: `config` (None, a preset name or a keyplace.Config),
 /// then `overrides` (None or a dict of "section.key" -> value, like --set).
 PyConfig ResolveConfig(const py::object& config, const py::object& overrides);
+/// `overrides` (None or a dict of "section.key" -> value) given to `builder`, not yet validated.
+void AddOverrides(const py::object& overrides, ConfigBuilder& builder);
 
 /// A map argument: a keyplace.Map (copied) or the path of a map file (read without the GIL).
 GlobalMap ToMap(const py::object& map);

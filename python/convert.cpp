@@ -16,7 +16,7 @@
 namespace keyplace::python {
 namespace {
 
-// A Python value as the text SetConfigValue parses: bools as true/false, floats by repr (the
+// A Python value as the text ConfigBuilder::Set parses: bools as true/false, floats by repr (the
 // shortest text that reads back the same double), everything else by str.
 std::string ConfigText(const py::handle& value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
@@ -34,6 +34,16 @@ std::vector<double> ToDoubles(const py::object& values, const std::string& what)
 
 }  // namespace
 
+void AddOverrides(const py::object& overrides, ConfigBuilder& builder) {
+  if (overrides.is_none()) return;
+  if (!py::isinstance<py::dict>(overrides)) {
+    throw py::type_error("overrides must be a dict of 'section.key' -> value");
+  }
+  for (const auto& [key, value] : overrides.cast<py::dict>()) {
+    builder.Set(py::str(key).cast<std::string>(), ConfigText(value), "overrides");
+  }
+}
+
 PyConfig ResolveConfig(const py::object& config, const py::object& overrides) {
   PyConfig resolved;
   if (py::isinstance<PyConfig>(config)) {
@@ -45,12 +55,10 @@ PyConfig ResolveConfig(const py::object& config, const py::object& overrides) {
     throw py::type_error("config must be None, a preset name or a keyplace.Config");
   }
   if (overrides.is_none()) return resolved;
-  if (!py::isinstance<py::dict>(overrides)) {
-    throw py::type_error("overrides must be a dict of 'section.key' -> value");
-  }
-  for (const auto& [key, value] : overrides.cast<py::dict>()) {
-    SetConfigValue(py::str(key).cast<std::string>(), ConfigText(value), resolved.config);
-  }
+  // Validated once, after the last override: settings valid only together pass in any order.
+  ConfigBuilder builder(resolved.config);
+  AddOverrides(overrides, builder);
+  resolved.config = builder.Build();
   return resolved;
 }
 

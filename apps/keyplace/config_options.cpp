@@ -42,16 +42,17 @@ Config ResolveConfig(const ConfigOptions& options, const std::function<void(Conf
                      const std::vector<std::string>& aliases) {
   Config config = PresetConfig(options.preset);
   if (after_preset) after_preset(config);
-  if (!options.file.empty()) ApplyConfigFile(options.file, config);
-  for (const std::string& alias : aliases) ApplyConfigAssignment(alias, config);
-  if (!options.scan_topic.empty()) SetConfigValue("input.scan_topic", options.scan_topic, config);
-  if (!options.odom_topic.empty()) SetConfigValue("input.odom_topic", options.odom_topic, config);
-  if (!options.laser_pose.empty()) SetConfigValue("input.laser_pose", options.laser_pose, config);
-  for (const std::string& assignment : options.assignments) {
-    ApplyConfigAssignment(assignment, config);
-  }
-  Validate(config);
-  return config;
+  ConfigBuilder builder(config);
+  if (!options.file.empty()) builder.File(options.file);
+  for (const std::string& alias : aliases) builder.Assign(alias, "");
+  if (!options.scan_topic.empty())
+    builder.Set("input.scan_topic", options.scan_topic, "--scan-topic");
+  if (!options.odom_topic.empty())
+    builder.Set("input.odom_topic", options.odom_topic, "--odom-topic");
+  if (!options.laser_pose.empty())
+    builder.Set("input.laser_pose", options.laser_pose, "--laser-pose");
+  for (const std::string& assignment : options.assignments) builder.Assign(assignment, "--set");
+  return builder.Build();  // validated once, after every source
 }
 
 nlohmann::json ConfigJson(const Config& config) {

@@ -1,6 +1,10 @@
 #include "keyplace/config/config.hpp"
 
+#include <algorithm>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "config/section_tables.hpp"
 
@@ -27,9 +31,16 @@ const ConfigFields<Config>& ConfigTable() {
   return fields;
 }
 
-// Validates the section `key` belongs to.
-void ValidateSection(const std::string& key, const Config& config) {
-  const std::string section = key.substr(0, key.find('.'));
+// The sections in table order, each validated as a whole (slam and localization with the shared
+// sections put in, as they run).
+const std::vector<std::string>& SectionNames() {
+  static const std::vector<std::string> names = {"input", "features", "odometry",     "mapping",
+                                                 "place", "slam",     "localization", "evaluation",
+                                                 "grid",  "merge"};
+  return names;
+}
+
+void ValidateSection(const std::string& section, const Config& config) {
   if (section == "input") Validate(config.input);
   if (section == "features") ValidateFlirtConfig(config.features);
   if (section == "odometry") ValidateScanOdometryConfig(config.odometry);
@@ -40,6 +51,38 @@ void ValidateSection(const std::string& key, const Config& config) {
   if (section == "evaluation") Validate(config.evaluation);
   if (section == "grid") Validate(config.grid);
   if (section == "merge") Validate(config.merge);
+}
+
+std::string SectionOf(const std::string& key) { return key.substr(0, key.find('.')); }
+
+// The error of an invalid section with the settings given to it: one setting is named as
+// "origin: key: error" (as a wrong type is), several are listed with their origins.
+std::string ExplainInvalidSection(const std::string& section, const std::string& error,
+                                  const std::vector<std::pair<std::string, std::string>>& given) {
+  std::vector<std::pair<std::string, std::string>> in_section;  // last value of each key
+  for (const auto& [assignment, origin] : given) {
+    const std::string key = assignment.substr(0, assignment.find('='));
+    if (SectionOf(key) != section) continue;
+    const auto same_key = [&](const auto& entry) {
+      return entry.first.substr(0, entry.first.find('=')) == key;
+    };
+    in_section.erase(std::remove_if(in_section.begin(), in_section.end(), same_key),
+                     in_section.end());
+    in_section.emplace_back(assignment, origin);
+  }
+  if (in_section.size() == 1) {
+    const auto& [assignment, origin] = in_section.front();
+    return (origin.empty() ? "" : origin + ": ") + assignment.substr(0, assignment.find('=')) +
+           ": " + error;
+  }
+  std::string text = section + ": " + error;
+  if (in_section.empty()) return text;
+  text += " (settings of " + section + " given:";
+  for (const auto& [assignment, origin] : in_section) {
+    text += " " + assignment + (origin.empty() ? "" : " from " + origin) + ";";
+  }
+  text.back() = ')';
+  return text;
 }
 
 }  // namespace
@@ -192,23 +235,49 @@ std::vector<std::pair<std::string, std::string>> ConfigKeyValues(const Config& c
   return ConfigTable().ToKeyValues(config);
 }
 
-void SetConfigValue(const std::string& key, const std::string& value, Config& config) {
+ConfigBuilder::ConfigBuilder(Config start) : config_(std::move(start)) {}
+
+ConfigBuilder& ConfigBuilder::Set(const std::string& key, const std::string& value,
+                                  const std::string& origin) {
+  const std::string where = origin.empty() ? "" : origin + ": ";
   const auto* field = ConfigTable().Find(key);
-  if (field == nullptr) throw std::invalid_argument("unknown configuration key '" + key + "'");
-  try {
-    field->set(value, config);
-    ValidateSection(key, config);
-  } catch (const std::invalid_argument& error) {
-    throw std::invalid_argument(key + ": " + error.what());
+  if (field == nullptr) {
+    throw std::invalid_argument(where + "unknown configuration key '" + key + "'");
   }
+  try {
+    field->set(value, config_);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(where + key + ": " + error.what());
+  }
+  given_.emplace_back(key + "=" + value, origin);
+  return *this;
 }
 
-void ApplyConfigAssignment(const std::string& assignment, Config& config) {
+ConfigBuilder& ConfigBuilder::Assign(const std::string& assignment, const std::string& origin) {
   const auto equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
     throw std::invalid_argument("--set '" + assignment + "': expected section.key=value");
   }
-  SetConfigValue(assignment.substr(0, equals), assignment.substr(equals + 1), config);
+  return Set(assignment.substr(0, equals), assignment.substr(equals + 1), origin);
+}
+
+Config ConfigBuilder::Build() const {
+  for (const std::string& section : SectionNames()) {
+    try {
+      ValidateSection(section, config_);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(ExplainInvalidSection(section, error.what(), given_));
+    }
+  }
+  return config_;
+}
+
+void SetConfigValue(const std::string& key, const std::string& value, Config& config) {
+  config = ConfigBuilder(config).Set(key, value, "").Build();
+}
+
+void ApplyConfigAssignment(const std::string& assignment, Config& config) {
+  config = ConfigBuilder(config).Assign(assignment, "").Build();
 }
 
 }  // namespace keyplace

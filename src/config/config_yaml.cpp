@@ -73,7 +73,7 @@ const char* KindOf(const YAML::Node& node) {
 }
 
 void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::string& source,
-               Config& config) {
+               ConfigBuilder& config) {
   const auto where = [&](const YAML::Node& at) {
     return source + ":" + std::to_string(at.Mark().line + 1) + ": ";
   };
@@ -97,11 +97,7 @@ void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::str
       }
       ApplyNode(value, key, source, config);
     } else if (value.IsScalar()) {
-      try {
-        SetConfigValue(key, value.Scalar(), config);
-      } catch (const std::invalid_argument& error) {
-        throw std::invalid_argument(where(entry.first) + error.what());
-      }
+      config.Set(key, value.Scalar(), source + ":" + std::to_string(entry.first.Mark().line + 1));
     } else {
       throw std::invalid_argument(where(entry.first) + key + ": expected a value, found " +
                                   KindOf(value));
@@ -136,7 +132,7 @@ std::string ConfigToYaml(const Config& config) {
   return out.str();
 }
 
-void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config) {
+ConfigBuilder& ConfigBuilder::Yaml(const std::string& yaml, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml);
@@ -144,16 +140,24 @@ void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config&
     throw std::invalid_argument(source + ":" + std::to_string(error.mark.line + 1) +
                                 ": malformed YAML: " + error.msg);
   }
-  if (root.IsNull()) return;  // an empty file changes nothing
-  ApplyNode(root, "", source, config);
+  if (!root.IsNull()) ApplyNode(root, "", source, *this);  // an empty file changes nothing
+  return *this;
 }
 
-void ApplyConfigFile(const std::string& path, Config& config) {
+ConfigBuilder& ConfigBuilder::File(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the configuration file");
   std::ostringstream text;
   text << in.rdbuf();
-  ApplyConfigYaml(text.str(), path, config);
+  return Yaml(text.str(), path);
+}
+
+void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config) {
+  config = ConfigBuilder(config).Yaml(yaml, source).Build();
+}
+
+void ApplyConfigFile(const std::string& path, Config& config) {
+  config = ConfigBuilder(config).File(path).Build();
 }
 
 }  // namespace keyplace

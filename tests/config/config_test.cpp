@@ -133,6 +133,67 @@ TEST(Config, AssignmentsAndFilesReportTheirErrors) {
   }
 }
 
+// Settings valid only together (min_range_m must stay below max_range_m, default 30 m): raising
+// both past the old maximum passes in either order, from --set assignments and within a file, and
+// is validated once, after the last.
+TEST(ConfigBuilder, SettingsThatDependOnEachOtherPassInEitherOrder) {
+  for (const bool min_first : {true, false}) {
+    ConfigBuilder builder;
+    if (min_first) {
+      builder.Assign("odometry.min_range_m=40").Assign("odometry.max_range_m=60");
+    } else {
+      builder.Assign("odometry.max_range_m=60").Assign("odometry.min_range_m=40");
+    }
+    const Config config = builder.Build();
+    EXPECT_EQ(config.odometry.min_range_m, 40.0) << min_first;
+    EXPECT_EQ(config.odometry.max_range_m, 60.0) << min_first;
+  }
+  for (const std::string yaml : {"odometry:\n  min_range_m: 40\n  max_range_m: 60\n",
+                                 "odometry:\n  max_range_m: 60\n  min_range_m: 40\n"}) {
+    Config config;
+    ApplyConfigYaml(yaml, "my.yaml", config);
+    EXPECT_EQ(config.odometry.min_range_m, 40.0) << yaml;
+    EXPECT_EQ(config.odometry.max_range_m, 60.0) << yaml;
+  }
+  // A file and a later --set: the file alone would be invalid (40 above the default 30 m).
+  const Config config = ConfigBuilder()
+                            .Yaml("odometry:\n  min_range_m: 40\n", "my.yaml")
+                            .Assign("odometry.max_range_m=60")
+                            .Build();
+  EXPECT_EQ(config.odometry.max_range_m, 60.0);
+}
+
+TEST(ConfigBuilder, AnInvalidSectionNamesTheSettingsGivenToItAndWhere) {
+  try {
+    ConfigBuilder()
+        .Yaml("odometry:\n  max_range_m: 60\n", "my.yaml")
+        .Assign("odometry.min_range_m=70")
+        .Build();
+    FAIL() << "min_range_m above max_range_m was accepted";
+  } catch (const std::invalid_argument& error) {
+    const std::string text = error.what();
+    EXPECT_NE(text.find("max_range_m must be > min_range_m"), std::string::npos) << text;
+    EXPECT_NE(text.find("odometry.max_range_m=60 from my.yaml:2"), std::string::npos) << text;
+    EXPECT_NE(text.find("odometry.min_range_m=70 from --set"), std::string::npos) << text;
+  }
+  // One setting: named as a wrong type is, origin first; the same key twice counts once.
+  try {
+    ConfigBuilder().Assign("mapping.min_overlap=0.5").Assign("mapping.min_overlap=1.5").Build();
+    FAIL() << "min_overlap 1.5 was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("--set: mapping.min_overlap: ", 0), 0u)
+        << error.what();
+  }
+  // Unknown keys and wrong types are refused at once, with their origin.
+  EXPECT_THROW(ConfigBuilder().Assign("odometry.nope=1"), std::invalid_argument);
+  try {
+    ConfigBuilder().Set("place.min_pairs", "x", "here");
+    FAIL() << "a text for an integer was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()), "here: place.min_pairs: 'x' is not an integer");
+  }
+}
+
 TEST(Config, NoNumberFieldTakesInfinityOrNaN) {
   int number_fields = 0;
   int real_fields = 0;

@@ -119,6 +119,21 @@ class ConfigTest(unittest.TestCase):
         self.assertEqual(keyplace.Config().to_dict()["place.min_pairs"], "10")
         self.assertEqual(set(keyplace.config_presets()), {"default", "paper", "strict"})
 
+    def test_settings_valid_only_together_pass_in_either_order(self):
+        # min_range_m must stay below max_range_m (default 30 m): validated after all overrides.
+        for overrides in ({"odometry.min_range_m": 40, "odometry.max_range_m": 60},
+                          {"odometry.max_range_m": 60, "odometry.min_range_m": 40}):
+            config = keyplace.Config(overrides=overrides)
+            self.assertEqual(float(config["odometry.min_range_m"]), 40, overrides)
+            self.assertEqual(float(config["odometry.max_range_m"]), 60, overrides)
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml") as file:
+            file.write("odometry:\n  min_range_m: 40\n")
+            file.flush()
+            config = keyplace.Config(file=file.name, overrides={"odometry.max_range_m": 60})
+            self.assertEqual(float(config["odometry.min_range_m"]), 40)
+        with self.assertRaisesRegex(ValueError, "odometry.min_range_m=70 from overrides"):
+            keyplace.Config(overrides={"odometry.min_range_m": 70, "odometry.max_range_m": 60})
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -63,8 +63,36 @@ std::vector<ConfigFieldInfo> DescribeConfig(const Config& config);
 /// Every field as ("section.key", text value), in table order.
 std::vector<std::pair<std::string, std::string>> ConfigKeyValues(const Config& config);
 
-/// Sets one field from text ("place.min_pairs", "12"), then validates its section. Throws
-/// std::invalid_argument naming the key for an unknown key, a wrong type or an invalid value.
+/// Settings from several sources (YAML files, --set assignments, single values) applied in order
+/// and validated once, after the last: settings that are valid only together (odometry.min_range_m
+/// and max_range_m) may come in any order and from any source. A key that does not exist or a
+/// value of the wrong type is refused at once, naming where it came from; an invalid section is
+/// refused by Build, naming the settings given to it and where each came from.
+class ConfigBuilder {
+ public:
+  explicit ConfigBuilder(Config start = Config{});
+
+  /// One field from text ("place.min_pairs", "12"); `origin` names it in errors ("my.yaml:3",
+  /// "--set"; empty: the key alone).
+  ConfigBuilder& Set(const std::string& key, const std::string& value, const std::string& origin);
+  /// "section.key=value" (the --set syntax).
+  ConfigBuilder& Assign(const std::string& assignment, const std::string& origin = "--set");
+  /// YAML text (any subset of the sections and keys); `source` names it, with the line, in errors.
+  ConfigBuilder& Yaml(const std::string& yaml, const std::string& source);
+  /// A YAML file; std::runtime_error when it cannot be read.
+  ConfigBuilder& File(const std::string& path);
+
+  /// The configuration, validated: std::invalid_argument for the first invalid section.
+  Config Build() const;
+
+ private:
+  Config config_;
+  std::vector<std::pair<std::string, std::string>> given_;  // (key=value, origin), in order
+};
+
+/// Sets one field from text ("place.min_pairs", "12"), then validates the configuration. Throws
+/// std::invalid_argument naming the key for an unknown key, a wrong type or an invalid value. For
+/// several settings that depend on each other use ConfigBuilder (validated after the last).
 void SetConfigValue(const std::string& key, const std::string& value, Config& config);
 
 /// "section.key=value" (the --set syntax) applied with SetConfigValue.
@@ -74,9 +102,10 @@ void ApplyConfigAssignment(const std::string& assignment, Config& config);
 /// field with its unit and doc as a comment. Loading it gives back the same configuration.
 std::string ConfigToYaml(const Config& config);
 
-/// Applies a YAML file (any subset of the sections and keys) to `config`. Throws
-/// std::invalid_argument naming the file, line and key for an unknown key, a wrong type, an
-/// invalid value or malformed YAML; std::runtime_error when the file cannot be read.
+/// Applies a YAML file (any subset of the sections and keys) to `config`, validated after its
+/// last key (ConfigBuilder). Throws std::invalid_argument naming the file, line and key for an
+/// unknown key, a wrong type, an invalid value or malformed YAML; std::runtime_error when the file
+/// cannot be read.
 void ApplyConfigFile(const std::string& path, Config& config);
 /// The same from YAML text; `source` names it in errors.
 void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config);

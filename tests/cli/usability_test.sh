@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# What a new user meets first, on tiny inputs (seconds, the committed 150-scan slice of the raw
+# FR079 log): every configuration source (--config, --set) applied before one validation, whatever
+# the order.
+# Usage: usability_test.sh KEYPLACE_BINARY SOURCE_DIR
+set -uo pipefail
+keyplace=$1
+source_dir=$2
+# shellcheck source=../support/script_checks.sh
+source "$source_dir/tests/support/script_checks.sh"
+raw=$source_dir/tests/data/ros2/fr079-raw-first150.log.gz  # 150 scans with odometry only
+bag=$source_dir/tests/data/ros2/mcap-zstd                   # the same as a ROS 2 bag
+
+# Validated once after every source: settings valid only together pass in either order (the
+# default max_range_m is 30 m), from --set and from a file followed by --set.
+for order in "min_range_m=40 max_range_m=60" "max_range_m=60 min_range_m=40"; do
+  read -r first second <<<"$order"
+  check "--set odometry.$first then odometry.$second" sh -c "'$keyplace' dump-config \
+    --set odometry.$first --set odometry.$second | grep -q '^  min_range_m: 40 '"
+done
+printf 'odometry:\n  min_range_m: 40\n' >"$work/min40.yaml"
+check "--config min_range_m=40 then --set max_range_m" "$keyplace" dump-config \
+  --config "$work/min40.yaml" --set odometry.max_range_m=60
+fails_with "min above max names both settings" "odometry.min_range_m=40 from $work/min40.yaml:2" \
+  "$keyplace" dump-config --config "$work/min40.yaml" --set odometry.max_range_m=35
+fails_with "one invalid setting named with its origin" "--set: mapping.min_overlap" \
+  "$keyplace" dump-config --set mapping.min_overlap=1.5
+
+finish usability_test
