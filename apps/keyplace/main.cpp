@@ -3,12 +3,29 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "config/spelling.hpp"
 
 namespace {
+
+// A first word that is no option and no command: CLI11 would say a subcommand is required.
+bool UnknownCommand(const CLI::App& app, const std::string& word) {
+  if (word.empty() || word.front() == '-') return false;
+  std::vector<std::string> commands;
+  for (const CLI::App* command : app.get_subcommands({})) {
+    if (command->get_name() == word) return false;
+    commands.push_back(command->get_name());
+  }
+  std::fprintf(stderr,
+               "keyplace: error: '%s' is not a keyplace command%s (keyplace --help lists them)\n",
+               word.c_str(), keyplace::DidYouMean(word, commands).c_str());
+  return true;
+}
 
 int Run(int argc, char** argv) {
   CLI::App app{
@@ -30,6 +47,7 @@ int Run(int argc, char** argv) {
   keyplace::cli::RegisterSweepCommand(app);
   keyplace::cli::RegisterReportCommand(app);
   keyplace::cli::RegisterDumpConfigCommand(app);
+  if (argc > 1 && UnknownCommand(app, argv[1])) return 1;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

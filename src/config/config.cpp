@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "config/section_tables.hpp"
+#include "config/spelling.hpp"
 
 namespace keyplace {
 namespace {
@@ -29,6 +30,12 @@ const ConfigFields<Config>& ConfigTable() {
     return table;
   }();
   return fields;
+}
+
+std::vector<std::string> ConfigKeys() {
+  std::vector<std::string> keys;
+  for (const auto& field : ConfigTable().fields()) keys.push_back(field.doc.name);
+  return keys;
 }
 
 // The sections in table order, each validated as a whole (slam and localization with the shared
@@ -242,7 +249,8 @@ ConfigBuilder& ConfigBuilder::Set(const std::string& key, const std::string& val
   const std::string where = origin.empty() ? "" : origin + ": ";
   const auto* field = ConfigTable().Find(key);
   if (field == nullptr) {
-    throw std::invalid_argument(where + "unknown configuration key '" + key + "'");
+    throw std::invalid_argument(where + "unknown configuration key '" + key + "'" +
+                                DidYouMean(key, ConfigKeys()));
   }
   try {
     field->set(value, config_);

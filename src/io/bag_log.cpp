@@ -47,11 +47,22 @@ class PoseAssembler {
   void CheckScans() const {
     const std::string& topic = config_.scan_topic;
     if (FindTopic(summary_, topic) == nullptr) {
-      Fail("no topic " + topic + " (input.scan_topic, --scan-topic); the bag has " +
-           TopicList(summary_));
+      Fail("no topic " + topic + " (input.scan_topic, --scan-topic); " + ScanTopicHint() +
+           "; the bag has " + TopicList(summary_));
     }
     CheckType(topic, types_.scan);
     if (contents_.scans.empty()) Fail("topic " + topic + " holds no scan");
+  }
+
+  // The topics of the scan type, as the flag that would read the first.
+  std::string ScanTopicHint() const {
+    std::string names;
+    for (const LogTopic& candidate : summary_.topics) {
+      if (candidate.type == types_.scan) names += (names.empty() ? "" : ", ") + candidate.name;
+    }
+    if (names.empty()) return std::string("no topic holds ") + types_.scan;
+    return std::string(types_.scan) + " on " + names + " (--scan-topic " +
+           names.substr(0, names.find(',')) + ")";
   }
 
   // Fills odometry_pose of every scan and CarmenLog::odometry.

@@ -55,10 +55,15 @@ std::vector<Pose2> ScanPoses(const CarmenLog& log, PoseSource source,
     const LogScan& scan = log.scans[i];
     const auto& pose = source == PoseSource::kCorrected ? scan.corrected_pose : scan.odometry_pose;
     if (!pose) {
+      // What to ask for instead: the CLI's --poses, PoseSource in the library.
+      const std::string hint =
+          log.corrected ? " (--poses corrected)"
+                        : " (a raw log: --poses icp matches its scans from the odometry, --poses "
+                          "odometry takes the odometry as it is)";
       throw std::invalid_argument(log.path + ": scan " + std::to_string(i) + " (line " +
                                   std::to_string(scan.line) + ") has no " + ToString(source) +
                                   " pose; this log holds " +
-                                  (log.corrected ? "corrected" : "odometry") + " poses");
+                                  (log.corrected ? "corrected" : "odometry") + " poses" + hint);
     }
     poses.push_back(*pose);
   }

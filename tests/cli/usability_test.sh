@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What a new user meets first, on tiny inputs (seconds, the committed 150-scan slice of the raw
 # FR079 log): every configuration source (--config, --set) applied before one validation, whatever
-# the order.
+# the order; "did you mean" for commands and keys; hints in the first errors.
 # Usage: usability_test.sh KEYPLACE_BINARY SOURCE_DIR
 set -uo pipefail
 keyplace=$1
@@ -25,5 +25,28 @@ fails_with "min above max names both settings" "odometry.min_range_m=40 from $wo
   "$keyplace" dump-config --config "$work/min40.yaml" --set odometry.max_range_m=35
 fails_with "one invalid setting named with its origin" "--set: mapping.min_overlap" \
   "$keyplace" dump-config --set mapping.min_overlap=1.5
+
+# "Did you mean": a mistyped command or key names the closest ones; nothing close, no guess.
+fails_with "mistyped command" "'mpa' is not a keyplace command; did you mean 'map'?" \
+  "$keyplace" mpa "$raw"
+fails_with "mistyped command, nothing close" "'zzzz' is not a keyplace command (keyplace --help" \
+  "$keyplace" zzzz
+fails_with "mistyped key" \
+  "unknown configuration key 'odometry.max_rang_m'; did you mean 'odometry.max_range_m'?" \
+  "$keyplace" dump-config --set odometry.max_rang_m=60
+fails_with "key in the wrong section" "did you mean 'mapping.min_overlap'?" \
+  "$keyplace" dump-config --set place.min_overlap=0.5
+printf 'odometry:\n  min_rang_m: 1\n' >"$work/typo.yaml"
+fails_with "mistyped key in a file" \
+  "typo.yaml:2: unknown configuration key 'odometry.min_rang_m'; did you mean 'odometry.min_range_m'?" \
+  "$keyplace" dump-config --config "$work/typo.yaml"
+
+# Hints in the first errors a new user meets: a raw log (odometry poses only) asked for its
+# corrected poses names --poses icp; a bag without the scan topic names its LaserScan topics.
+fails_with "raw log without --poses icp" "--poses icp matches its scans from the odometry" \
+  "$keyplace" map "$raw" --poses corrected
+fails_with "bag without the scan topic" \
+  "sensor_msgs/msg/LaserScan on /scan (--scan-topic /scan)" \
+  "$keyplace" map "$bag" --scan-topic /base_scan
 
 finish usability_test

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "config/spelling.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -192,6 +193,31 @@ TEST(ConfigBuilder, AnInvalidSectionNamesTheSettingsGivenToItAndWhere) {
   } catch (const std::invalid_argument& error) {
     EXPECT_EQ(std::string(error.what()), "here: place.min_pairs: 'x' is not an integer");
   }
+}
+
+// "Did you mean": swapped neighbours count one edit; a key in the wrong section finds its own; a
+// short name within one edit only (no guess for 'place.nope'); at most three names.
+TEST(ConfigBuilder, UnknownKeysNameTheClosestKeys) {
+  EXPECT_EQ(EditDistance("mpa", "map"), 1u);
+  EXPECT_EQ(EditDistance("odometry.max_rang_m", "odometry.max_range_m"), 1u);
+  EXPECT_EQ(EditDistance("", "abc"), 3u);
+  EXPECT_EQ(DidYouMean("mpa", {"map", "merge", "info"}), "; did you mean 'map'?");
+  EXPECT_EQ(DidYouMean("zzzz", {"map", "merge", "info"}), "");
+  try {
+    ConfigBuilder().Set("place.min_overlap", "0.5", "--set");
+    FAIL() << "a key of another section was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "--set: unknown configuration key 'place.min_overlap'; did you mean "
+              "'mapping.min_overlap'?");
+  }
+  EXPECT_EQ(ErrorOfYaml("odometry:\n  max_rang_m: 60\n"),
+            "my.yaml:2: unknown configuration key 'odometry.max_rang_m'; did you mean "
+            "'odometry.max_range_m'?");
+  EXPECT_LE(ClosestNames("odometry.icp.x", {"odometry.icp.a", "odometry.icp.b", "odometry.icp.c",
+                                            "odometry.icp.d"})
+                .size(),
+            3u);
 }
 
 TEST(Config, NoNumberFieldTakesInfinityOrNaN) {

@@ -147,6 +147,8 @@ TEST(Ros1Bag, AMissingScanTopicListsTheTopics) {
   const std::string error = ErrorOf(Fr079Bag(), config);
   ExpectContains(error, Fr079Bag());
   ExpectContains(error, "no topic /base_scan");
+  // The scan topics first, as the flag that reads the first of them.
+  ExpectContains(error, "sensor_msgs/LaserScan on /scan (--scan-topic /scan)");
   ExpectContains(error, "/scan (sensor_msgs/LaserScan, 4934)");
   ExpectContains(error, "/odom (nav_msgs/Odometry, 8951)");
 }

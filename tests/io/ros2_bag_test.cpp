@@ -176,6 +176,7 @@ TEST(Ros2Bag, AMissingScanTopicListsTheBagsTopics) {
   config.scan_topic = "/base_scan";
   const std::string error = ErrorOf(Fixture("mcap-zstd"), config);
   ExpectContains(error, Fixture("mcap-zstd") + ": no topic /base_scan (input.scan_topic");
+  ExpectContains(error, "sensor_msgs/msg/LaserScan on /scan (--scan-topic /scan)");
   ExpectContains(error, "/scan (sensor_msgs/msg/LaserScan, 150)");
 }
 
