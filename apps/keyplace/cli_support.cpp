@@ -148,28 +148,53 @@ Progress::Progress(std::string label, std::size_t total)
       start_(std::chrono::steady_clock::now()),
       last_print_(start_) {
   const char* env = std::getenv("KEYPLACE_PROGRESS");
-  enabled_ = env != nullptr ? std::string(env) == "1" : isatty(fileno(stderr)) != 0;
+  const std::string setting = env != nullptr ? env : "";
+  if (setting == "0") {
+    mode_ = Mode::kOff;
+  } else if (setting == "1") {
+    mode_ = Mode::kBar;
+  } else if (setting == "lines") {
+    mode_ = Mode::kLines;
+  } else {
+    mode_ = isatty(fileno(stderr)) != 0 ? Mode::kBar : Mode::kLines;
+  }
 }
 
 void Progress::Update(std::size_t done) {
-  if (!enabled_ || total_ == 0) return;
+  if (mode_ == Mode::kOff || total_ == 0) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_print_ < std::chrono::milliseconds(250) && done < total_) return;
+  const auto interval = mode_ == Mode::kBar ? std::chrono::duration<double>(0.25)
+                                            : std::chrono::duration<double>(kProgressLineSeconds);
+  if (started_ && now - last_print_ < interval && done < total_) return;
+  if (mode_ == Mode::kLines && done == total_) return;  // Finish says it
+  started_ = true;
   last_print_ = now;
   const double elapsed_s = std::chrono::duration<double>(now - start_).count();
   const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-  const double eta_s = fraction > 0.0 ? elapsed_s * (1.0 - fraction) / fraction : 0.0;
-  fmt::print(stderr, "\r{}  {}/{}  {:3.0f} %  ETA {:.0f} s   ", label_, done, total_,
-             100.0 * fraction, eta_s);
+  const std::string eta = fraction > 0.0
+                              ? fmt::format("ETA {:.0f} s", elapsed_s * (1.0 - fraction) / fraction)
+                              : std::string("started");
+  if (mode_ == Mode::kBar) {
+    fmt::print(stderr, "\r{}  {}/{}  {:3.0f} %  {}   ", label_, done, total_, 100.0 * fraction,
+               eta);
+  } else {
+    fmt::print(stderr, "keyplace: {}  {}/{}  {:.0f} %  {}\n", label_, done, total_,
+               100.0 * fraction, eta);
+  }
   std::fflush(stderr);
 }
 
 void Progress::Finish() {
-  if (!enabled_ || total_ == 0) return;
+  if (mode_ == Mode::kOff || total_ == 0) return;
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  fmt::print(stderr, "\r{}  {}/{}  done in {:.1f} s          \n", label_, total_, total_,
-             elapsed_s);
+  if (mode_ == Mode::kBar) {
+    fmt::print(stderr, "\r{}  {}/{}  done in {:.1f} s          \n", label_, total_, total_,
+               elapsed_s);
+  } else {
+    fmt::print(stderr, "keyplace: {}  {}/{}  done in {:.1f} s\n", label_, total_, total_,
+               elapsed_s);
+  }
 }
 
 StageProgress StageProgressBar() {

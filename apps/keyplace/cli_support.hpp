@@ -89,8 +89,10 @@ nlohmann::json GridAgreementJson(const GridAgreement& agreement);
 /// there); nothing when `text` is empty.
 void ApplyScanRange(const std::string& text, LogInputOptions& options);
 
-/// A progress line on stderr ("label  123/456  27 %  ETA 12 s"), at most a few times a second,
-/// and only when stderr is a terminal or KEYPLACE_PROGRESS=1.
+/// Progress on stderr. On a terminal a bar that rewrites itself ("label  123/456  27 %  ETA 12 s"),
+/// at most a few times a second. Elsewhere (a log file, CI) whole lines: one when the work starts,
+/// one every kProgressLineSeconds and one when it ends ("keyplace: label  456/456  done in 80.1
+/// s"). KEYPLACE_PROGRESS=0 prints nothing, =1 the bar, =lines the lines, wherever stderr goes.
 class Progress {
  public:
   Progress(std::string label, std::size_t total);
@@ -98,12 +100,17 @@ class Progress {
   void Finish();
 
  private:
+  enum class Mode { kOff, kBar, kLines };
   std::string label_;
   std::size_t total_;
-  bool enabled_;
+  Mode mode_;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_print_;
+  bool started_ = false;
 };
+
+/// Seconds between two progress lines when stderr is not a terminal.
+constexpr double kProgressLineSeconds = 5.0;
 
 /// Progress lines for the stages of PrepareLogInputs (one Progress per stage).
 StageProgress StageProgressBar();

@@ -162,8 +162,8 @@ void RunMerge(const MergeCommandOptions& options) {
   // The library names the maps by their logs; the user gave these files.
   const MergeResult result = [&] {
     try {
-      // A progress line on stderr (a terminal, or KEYPLACE_PROGRESS=1): recognising B's submaps
-      // in A is the long part.
+      // Progress on stderr (Progress: a bar on a terminal, lines otherwise): recognising B's
+      // submaps in A is the long part.
       return MergeMaps(a, b, config.place, config.merge,
                        [bar = StageProgressBar()](std::size_t done, std::size_t total) {
                          bar("submaps of B", done, total);
@@ -196,8 +196,8 @@ void RegisterMergeCommand(CLI::App& app) {
       "in A, the largest group of recognitions that agree on where B lies gives the transform "
       "(at least merge.min_agreeing), B is moved into A's frame and appended. Refuses, saying "
       "why, when no reliable overlap exists. Uses the strict preset unless --preset says "
-      "otherwise. A progress line with ETA on stderr when it is a terminal or KEYPLACE_PROGRESS=1 "
-      "(docs/MERGE.md).");
+      "otherwise. Progress with ETA on stderr: a bar on a terminal, a line every 5 s otherwise "
+      "(KEYPLACE_PROGRESS=0 off, =1 the bar, =lines the lines; docs/MERGE.md).");
   command->add_option("a", options->map_a, "Map A (.kpm): the frame of the result")
       ->required()
       ->check(CLI::ExistingFile);

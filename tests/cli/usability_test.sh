@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # What a new user meets first, on tiny inputs (seconds, the committed 150-scan slice of the raw
 # FR079 log): every configuration source (--config, --set) applied before one validation, whatever
-# the order; "did you mean" for commands and keys; hints in the first errors.
+# the order; "did you mean" for commands and keys; hints in the first errors; progress lines off
+# a terminal.
 # Usage: usability_test.sh KEYPLACE_BINARY SOURCE_DIR
 set -uo pipefail
 keyplace=$1
@@ -48,5 +49,21 @@ fails_with "raw log without --poses icp" "--poses icp matches its scans from the
 fails_with "bag without the scan topic" \
   "sensor_msgs/msg/LaserScan on /scan (--scan-topic /scan)" \
   "$keyplace" map "$bag" --scan-topic /base_scan
+
+# Progress: whole lines on stderr when it is not a terminal (the first scan, then every few
+# seconds, then the end), none with KEYPLACE_PROGRESS=0, the bar with KEYPLACE_PROGRESS=1.
+(unset KEYPLACE_PROGRESS; "$keyplace" features "$raw" --scans 0:30 >/dev/null 2>"$work/lines.err")
+check "progress lines off a terminal" /usr/bin/python3 -c "
+import re, sys
+lines = open(sys.argv[1]).read().split('\n')
+assert '\r' not in ''.join(lines), lines
+progress = [l for l in lines if l.startswith('keyplace: features  ')]
+assert re.fullmatch(r'keyplace: features  1/30  3 %  ETA [0-9]+ s', progress[0]), progress
+assert re.fullmatch(r'keyplace: features  30/30  done in [0-9.]+ s', progress[-1]), progress
+" "$work/lines.err"
+KEYPLACE_PROGRESS=0 "$keyplace" features "$raw" --scans 0:30 >/dev/null 2>"$work/quiet.err"
+check "no progress with KEYPLACE_PROGRESS=0" test ! -s "$work/quiet.err"
+KEYPLACE_PROGRESS=1 "$keyplace" features "$raw" --scans 0:30 >/dev/null 2>"$work/bar.err"
+check "the bar with KEYPLACE_PROGRESS=1" grep -q $'\rfeatures  30/30  done in' "$work/bar.err"
 
 finish usability_test
