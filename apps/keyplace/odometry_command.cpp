@@ -19,6 +19,7 @@
 #include "keyplace/eval/odometry_evaluation.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/io/relations.hpp"
+#include "keyplace/io/trajectory_file.hpp"
 #include "odometry_output.hpp"
 
 namespace keyplace::cli {
@@ -27,6 +28,7 @@ namespace {
 struct OdometryOptions {
   std::string input;
   std::string out_path;
+  std::string trajectory_format = "tsv";
   std::string relations_path;
   std::string relation_errors_path;
   std::string steps_path;
@@ -102,7 +104,16 @@ void RunOdometry(const OdometryOptions& options) {
                      {"odometry", DriftJson(drift.odometry)}};
   }
 
-  if (!options.out_path.empty()) WriteTrajectoryTsv(options.out_path, run.icp_trajectory);
+  if (!options.out_path.empty()) {
+    if (ParseTrajectoryFormat(options.trajectory_format) == TrajectoryFormat::kTum) {
+      std::vector<TrajectoryPose> poses;
+      for (const TimedPose& pose : run.icp_trajectory)
+        poses.push_back({pose.timestamp_s, pose.pose});
+      WriteTumTrajectory(options.out_path, poses);
+    } else {
+      WriteTrajectoryTsv(options.out_path, run.icp_trajectory);
+    }
+  }
   if (!options.steps_path.empty()) WriteStepsTsv(options.steps_path, steps);
   if (!options.json_path.empty()) WriteJson(options.json_path, json);
 }
@@ -132,7 +143,12 @@ void RegisterOdometryCommand(CLI::App& app) {
       ->check(CLI::ExistingPath);
   command->add_option("--out", options->out_path,
                       "write the ICP trajectory as TSV: ipc timestamp (s), x (m), y (m), theta "
-                      "(rad), one row per scan in processing order");
+                      "(rad), one row per scan in processing order (or TUM: --trajectory-format)");
+  command
+      ->add_option("--trajectory-format", options->trajectory_format,
+                   "format of --out: tsv or tum (timestamp tx ty tz qx qy qz qw, as evo reads it)")
+      ->check(CLI::IsMember({"tsv", "tum"}))
+      ->capture_default_str();
   command
       ->add_option("--relations", options->relations_path,
                    "Kümmerle relation file (t_a t_b dx dy dz droll dpitch dyaw; times are "

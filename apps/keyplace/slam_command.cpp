@@ -18,6 +18,7 @@
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/slam_evaluation.hpp"
 #include "keyplace/io/relations.hpp"
+#include "keyplace/io/trajectory_file.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "paper_tables.hpp"
@@ -30,6 +31,7 @@ struct SlamOptions {
   std::string input;
   std::string out_path;
   std::string trajectory_path;
+  std::string trajectory_format = "tsv";
   std::string truth_path;
   std::string index_path;
   std::string relations_path;
@@ -89,7 +91,17 @@ void RunSlam(const SlamOptions& options) {
   std::optional<OccupancyGrid> grid;
   if (!options.grid_path.empty()) grid = SlamOccupancyGrid(run, inputs, config.grid);
   if (!options.out_path.empty()) SaveMap(run.map, options.out_path);
-  if (!options.trajectory_path.empty()) WriteTrajectoryTsv(options.trajectory_path, run);
+  if (!options.trajectory_path.empty()) {
+    if (ParseTrajectoryFormat(options.trajectory_format) == TrajectoryFormat::kTum) {
+      std::vector<TrajectoryPose> poses;
+      for (const OnlineSlam::ScanPose& pose : run.trajectory) {
+        poses.push_back({pose.timestamp_s, pose.T_world_robot});
+      }
+      WriteTumTrajectory(options.trajectory_path, poses);
+    } else {
+      WriteTrajectoryTsv(options.trajectory_path, run);
+    }
+  }
   const SlamEvaluation evaluation = EvaluateSlam(
       run, truth ? &*truth : nullptr, relations ? &*relations : nullptr, config.evaluation);
   if (!options.loops_path.empty()) WriteLoopsTsv(options.loops_path, run, evaluation.loops);
@@ -141,7 +153,13 @@ void RegisterSlamCommand(CLI::App& app) {
                       "--truth it is checked against the grid at the corrected poses");
   command->add_option("--trajectory", options->trajectory_path,
                       "write every scan's optimised pose (TSV: scan_index, timestamp, x, y, theta, "
-                      "submap, ICP pose)");
+                      "submap, ICP pose; or TUM with --trajectory-format tum)");
+  command
+      ->add_option("--trajectory-format", options->trajectory_format,
+                   "format of --trajectory: tsv (keyplace's columns) or tum (timestamp tx ty tz "
+                   "qx qy qz qw, as evo reads it)")
+      ->check(CLI::IsMember({"tsv", "tum"}))
+      ->capture_default_str();
   command->add_option("--truth", options->truth_path, "corrected log for ATE / RPE (needs --index)")
       ->check(CLI::ExistingFile);
   command->add_option("--index", options->index_path, "raw_index corrected_index TSV")

@@ -2,7 +2,7 @@
 # What a new user meets first, on tiny inputs (seconds, the committed 150-scan slice of the raw
 # FR079 log): every configuration source (--config, --set) applied before one validation, whatever
 # the order; "did you mean" for commands and keys; hints in the first errors; progress lines off
-# a terminal.
+# a terminal; TUM trajectories.
 # Usage: usability_test.sh KEYPLACE_BINARY SOURCE_DIR
 set -uo pipefail
 keyplace=$1
@@ -65,5 +65,32 @@ KEYPLACE_PROGRESS=0 "$keyplace" features "$raw" --scans 0:30 >/dev/null 2>"$work
 check "no progress with KEYPLACE_PROGRESS=0" test ! -s "$work/quiet.err"
 KEYPLACE_PROGRESS=1 "$keyplace" features "$raw" --scans 0:30 >/dev/null 2>"$work/bar.err"
 check "the bar with KEYPLACE_PROGRESS=1" grep -q $'\rfeatures  30/30  done in' "$work/bar.err"
+
+# --trajectory-format tum: odometry --out and slam --trajectory as `stamp x y z qx qy qz qw`, the
+# same poses as the TSV (heading from the quaternion).
+check "odometry --trajectory-format tum" "$keyplace" odometry "$raw" --scans 0:40 \
+  --out "$work/odo.tum" --trajectory-format tum
+check "odometry tsv" "$keyplace" odometry "$raw" --scans 0:40 --out "$work/odo.tsv"
+check "slam --trajectory-format tum" "$keyplace" slam "$raw" --trajectory "$work/slam.tum" \
+  --trajectory-format tum
+check "slam tsv" "$keyplace" slam "$raw" --trajectory "$work/slam.tsv"
+check "TUM files hold the TSV's poses" /usr/bin/python3 -c "
+import math, sys
+def rows(path, columns):
+    return [[float(v) for v in l.split()] for l in open(path)
+            if l.strip() and not l.startswith('#') and not l.startswith('scan_index')]
+for tum, tsv, stamp, x, y, theta, count in [(sys.argv[1], sys.argv[2], 0, 1, 2, 3, 40),
+                                            (sys.argv[3], sys.argv[4], 1, 2, 3, 4, 150)]:
+    a, b = rows(tum, 8), rows(tsv, 0)
+    assert len(a) == len(b) == count, (tum, len(a), len(b))
+    for r, s in zip(a, b):
+        assert len(r) == 8 and r[3] == r[4] == r[5] == 0, r
+        assert abs(r[6] ** 2 + r[7] ** 2 - 1) < 1e-12, r
+        assert abs(r[0] - s[stamp]) < 1e-6 and abs(r[1] - s[x]) < 1e-6 and abs(r[2] - s[y]) < 1e-6
+        d = 2 * math.atan2(r[6], r[7]) - s[theta]
+        assert abs(math.atan2(math.sin(d), math.cos(d))) < 1e-6, (r, s)
+" "$work/odo.tum" "$work/odo.tsv" "$work/slam.tum" "$work/slam.tsv"
+fails_with "unknown trajectory format" "--trajectory-format" "$keyplace" odometry "$raw" \
+  --out "$work/x.txt" --trajectory-format kitti
 
 finish usability_test
