@@ -38,6 +38,39 @@ std::vector<std::string> ConfigKeys() {
   return keys;
 }
 
+// Switches removed after they were measured worse than their default (docs/REGISTRATION.md,
+// "Removed options"), and the settings that only they used. Maps and dumps of earlier versions
+// record them: a switch at its old default (false: the method as it is now) and the settings
+// that had no effect without it are accepted and ignored; a switch turned on is refused, naming
+// why, since the method it asks for no longer exists.
+const std::vector<std::string>& RemovedSwitches() {
+  static const std::vector<std::string> keys = {"odometry.sparse_normals_from_map",
+                                                "odometry.odometry_prior"};
+  return keys;
+}
+
+const std::vector<std::string>& RemovedSettings() {
+  static const std::vector<std::string> keys = {
+      "odometry.prior_point_sigma_m", "odometry.prior_sigma_base_m",
+      "odometry.prior_sigma_per_m",   "odometry.prior_sigma_base_rad",
+      "odometry.prior_sigma_per_rad", "odometry.prior_sigma_rad_per_m"};
+  return keys;
+}
+
+// True when `key` is a removed one whose `value` changes nothing (see above); throws for a
+// removed switch turned on.
+bool IgnoredRemovedKey(const std::string& key, const std::string& value) {
+  const auto named = [&](const std::vector<std::string>& keys) {
+    return std::find(keys.begin(), keys.end(), key) != keys.end();
+  };
+  if (named(RemovedSettings())) return true;
+  if (!named(RemovedSwitches())) return false;
+  if (value == "false" || value == "0") return true;
+  throw std::invalid_argument(key +
+                              " was removed: measured worse than without it "
+                              "(docs/REGISTRATION.md, \"Removed options\"); leave it out");
+}
+
 // The sections in table order, each validated as a whole (slam and localization with the shared
 // sections put in, as they run).
 const std::vector<std::string>& SectionNames() {
@@ -249,6 +282,11 @@ ConfigBuilder& ConfigBuilder::Set(const std::string& key, const std::string& val
   const std::string where = origin.empty() ? "" : origin + ": ";
   const auto* field = ConfigTable().Find(key);
   if (field == nullptr) {
+    try {
+      if (IgnoredRemovedKey(key, value)) return *this;
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(where + error.what());
+    }
     throw std::invalid_argument(where + "unknown configuration key '" + key + "'" +
                                 DidYouMean(key, ConfigKeys()));
   }

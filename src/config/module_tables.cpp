@@ -78,9 +78,6 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
         .Double("source_min_spacing_m", &C::source_min_spacing_m, "m",
                 "registered scan: skip points closer than this to the previous kept one")
         .Int("local_map_scans", &C::local_map_scans, "", "key scans in the local map")
-        .Bool("sparse_normals_from_map", &C::sparse_normals_from_map,
-              "a map point its own scan gives no normal (too sparse there, or not line-like) "
-              "gets one fitted to the whole local map")
         .Double("keyframe_translation_m", &C::keyframe_translation_m, "m",
                 "a scan becomes a key scan after moving this far ...")
         .Double("keyframe_rotation_rad", &C::keyframe_rotation_rad, "rad",
@@ -102,19 +99,6 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
                 "translation step of the search")
         .Double("recovery_step_rotation_rad", &C::recovery_step_rotation_rad, "rad",
                 "rotation step of the search")
-        .Bool("odometry_prior", &C::odometry_prior,
-              "ICP includes the odometry increment as a prior on the pose")
-        .Double("prior_point_sigma_m", &C::prior_point_sigma_m, "m",
-                "prior: standard deviation of a point-to-line residual")
-        .Double("prior_sigma_base_m", &C::prior_sigma_base_m, "m",
-                "prior: odometry translation sigma of a step, base ...")
-        .Double("prior_sigma_per_m", &C::prior_sigma_per_m, "m/m", "... plus this per m moved")
-        .Double("prior_sigma_base_rad", &C::prior_sigma_base_rad, "rad",
-                "prior: odometry rotation sigma of a step, base ...")
-        .Double("prior_sigma_per_rad", &C::prior_sigma_per_rad, "rad/rad",
-                "... plus this per rad turned ...")
-        .Double("prior_sigma_rad_per_m", &C::prior_sigma_rad_per_m, "rad/m",
-                "... plus this per m moved")
         .Nested("icp", &C::icp, IcpConfigFields());
     return table;
   }();

@@ -20,23 +20,6 @@ void Require(bool condition, const char* field, const char* what) {
   }
 }
 
-// The odometry increment as a prior on the laser pose predicted from it (docs/REGISTRATION.md,
-// "Odometry prior").
-IcpPosePrior OdometryPrior(const Pose2& predicted_T_world_laser, const Pose2& odometry_increment,
-                           const ScanOdometryConfig& c) {
-  const double step_m = TranslationNorm(odometry_increment);
-  const double sigma_m = c.prior_sigma_base_m + c.prior_sigma_per_m * step_m;
-  const double sigma_rad = c.prior_sigma_base_rad +
-                           c.prior_sigma_per_rad * std::abs(odometry_increment.theta) +
-                           c.prior_sigma_rad_per_m * step_m;
-  const double point_variance = c.prior_point_sigma_m * c.prior_point_sigma_m;
-  IcpPosePrior prior;
-  prior.T_target_source_mean = predicted_T_world_laser;
-  prior.information.diagonal() << point_variance / (sigma_m * sigma_m),
-      point_variance / (sigma_m * sigma_m), point_variance / (sigma_rad * sigma_rad);
-  return prior;
-}
-
 void RecordIcp(const IcpResult& icp, ScanOdometryResult* result) {
   result->icp_status = icp.status;
   result->iterations = icp.iterations;
@@ -91,20 +74,6 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
           "recovery_step_translation_m", "must be finite and >= 0.01");
   Require(std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
           "recovery_step_rotation_rad", "must be finite and >= 0.001");
-  // The prior's information is prior_point_sigma_m^2 / sigma^2: these bounds keep it finite.
-  Require(std::isfinite(c.prior_point_sigma_m) && c.prior_point_sigma_m > 0.0 &&
-              c.prior_point_sigma_m <= 10.0,
-          "prior_point_sigma_m", "must be in (0, 10]");
-  Require(std::isfinite(c.prior_sigma_base_m) && c.prior_sigma_base_m >= 1e-6, "prior_sigma_base_m",
-          "must be finite and >= 1e-6");
-  Require(std::isfinite(c.prior_sigma_per_m) && c.prior_sigma_per_m >= 0.0, "prior_sigma_per_m",
-          "must be finite and >= 0");
-  Require(std::isfinite(c.prior_sigma_base_rad) && c.prior_sigma_base_rad >= 1e-6,
-          "prior_sigma_base_rad", "must be finite and >= 1e-6");
-  Require(std::isfinite(c.prior_sigma_per_rad) && c.prior_sigma_per_rad >= 0.0,
-          "prior_sigma_per_rad", "must be finite and >= 0");
-  Require(std::isfinite(c.prior_sigma_rad_per_m) && c.prior_sigma_rad_per_m >= 0.0,
-          "prior_sigma_rad_per_m", "must be finite and >= 0");
   // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 91 =
   // 11 011 poses (2-6 ms); this bound keeps a search under about a second.
   const double translations =
@@ -173,7 +142,6 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
                              k.normals_world.valid.end());
   }
   target_ = std::make_unique<IcpTarget>(map_points_, std::move(map_normals), config_.icp);
-  if (config_.sparse_normals_from_map) target_->FillMissingNormals(config_.icp);
   last_keyframe_T_world_laser_ = T_world_laser;
 }
 
@@ -262,14 +230,8 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     } else {
       const std::vector<Eigen::Vector2d> source =
           SubsampleBySpacing(points, config_.source_min_spacing_m);
-      // Without a measured increment (no odometry now or at the previous scan) the prediction is
-      // a guess, not a measurement to be held to.
-      std::optional<IcpPosePrior> prior;
-      if (config_.odometry_prior && increment_measured) {
-        prior = OdometryPrior(predicted_T_world_laser, odometry_increment, config_);
-      }
-      const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp,
-                                             prior ? &*prior : nullptr);
+      const IcpResult icp =
+          AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
       RecordIcp(icp, &result);
       if (!icp.converged) {
         result.status = icp.status == IcpStatus::kTooFewPoints

@@ -37,14 +37,9 @@ struct ScanOdometryConfig {
   // robot therefore does not wash the map out with copies of one view.
   int local_map_scans = 10;
   // A key scan's point gets its normal from a line fitted within its own scan (no cross-scan
-  // noise). Where that fails (fewer than two neighbours within
-  // icp.normal_max_neighbour_distance_m: a wall seen head-on beyond 17 m with 1 deg beams, 34 m
-  // with 0.5 deg, and much nearer at a grazing angle; or a neighbourhood that is not line-like),
-  // sparse_normals_from_map fits it to the whole local map instead, whose several scans sample
-  // the wall more densely; otherwise such points have no normal and ICP does not use them. Off by
-  // default: better local relation errors on every log with relations, but a worse SLAM ATE on
-  // both development logs (docs/REGISTRATION.md, "Normals from the local map").
-  bool sparse_normals_from_map = false;
+  // noise); where that fails (too sparse, not line-like) the point has no normal and ICP does not
+  // use it (fitting those to the whole local map was measured worse and removed:
+  // docs/REGISTRATION.md, "Removed options").
   double keyframe_translation_m = 0.1;
   double keyframe_rotation_rad = 0.0872664626;  // 5 deg
 
@@ -71,25 +66,6 @@ struct ScanOdometryConfig {
   double recovery_window_rotation_rad = 0.7853981634;  // 45 deg
   double recovery_step_translation_m = 0.1;
   double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
-
-  // The odometry as a prior of ICP. ICP from the prediction adds the odometry increment as a
-  // Gaussian prior on the pose (IcpPosePrior): where the scan measures the pose well the points
-  // decide, and along a direction they barely constrain (a long corridor whose far walls are too
-  // sparse for normals) the odometry does, instead of nearest-neighbour associations sliding the
-  // pose along it. The odometry's standard deviation for one step grows with the step:
-  // translation prior_sigma_base_m + prior_sigma_per_m |step|, rotation prior_sigma_base_rad +
-  // prior_sigma_per_rad |turn| + prior_sigma_rad_per_m |step|; prior_point_sigma_m, the standard
-  // deviation of a point-to-line residual, sets the scale between the two. Only with odometry,
-  // and not for the retry of the recovery search (the prediction is suspect there). Off by
-  // default: it did not make SLAM better on the development logs and broke the hospital bag's
-  // (docs/REGISTRATION.md, "Odometry prior").
-  bool odometry_prior = false;
-  double prior_point_sigma_m = 0.05;
-  double prior_sigma_base_m = 0.03;
-  double prior_sigma_per_m = 0.1;
-  double prior_sigma_base_rad = 0.05;  // 2.9 deg
-  double prior_sigma_per_rad = 0.3;
-  double prior_sigma_rad_per_m = 0.1;
 };
 
 /// Throws std::invalid_argument naming the first invalid field (including icp.*).
