@@ -214,8 +214,8 @@ TEST(ConfigBuilder, UnknownKeysNameTheClosestKeys) {
   EXPECT_EQ(ErrorOfYaml("odometry:\n  max_rang_m: 60\n"),
             "my.yaml:2: unknown configuration key 'odometry.max_rang_m'; did you mean "
             "'odometry.max_range_m'?");
-  EXPECT_LE(ClosestNames("odometry.icp.x", {"odometry.icp.a", "odometry.icp.b", "odometry.icp.c",
-                                            "odometry.icp.d"})
+  EXPECT_LE(ClosestNames("odometry.icp.x",
+                         {"odometry.icp.a", "odometry.icp.b", "odometry.icp.c", "odometry.icp.d"})
                 .size(),
             3u);
 }
