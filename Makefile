@@ -25,8 +25,8 @@ SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return
 # DescriptorIndex.*, PlaceDatabase.*, Ros1Bag*).
 SANITIZE_SKIP := ^(GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog|DescriptorIndex.SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog|BagMap.Fr079BagGivesTheMapOfTheLogRebuiltFromIt)$$
 
-.PHONY: all deps configure build demo test test-sanitize fuzz bench report format format-check tidy \
-  install clean
+.PHONY: all deps configure build build-demo demo test test-fast test-slow build-sanitize \
+  test-sanitize fuzz bench report format format-check tidy install clean
 
 all: build
 
@@ -39,23 +39,39 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
+# What the demo runs and nothing else: the library, the keyplace command and the streaming example
+# (no tests, fuzz replays, benchmarks or Python module; `make test` builds those).
+build-demo: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target keyplace_cli localize_stream
+
 # The main job on the bundled data set, printing its results.
-demo: build
+demo: build-demo
 	@bash scripts/demo.sh $(KEYPLACE) $(DEMO_LOG) $(DEMO_OUT)
 
-test: build format-check
-	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+# Every test: the fast ones first (unit tests, fuzz replays, short scripts; a failure stops here),
+# then the end-to-end scripts labelled `slow` (minutes each; tests/CMakeLists.txt).
+test: build format-check test-fast test-slow
+
+test-fast: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE '^slow$$'
+
+test-slow: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L '^slow$$'
 
 # Everything built with AddressSanitizer + UndefinedBehaviorSanitizer in $(SANITIZE_DIR) (-O1, with
-# debug lines for the stacks), then the whole suite under them; the benchmarks are not built (no
-# test runs them).
-test-sanitize: deps
+# debug lines for the stacks), then the suite under them but the `slow` end-to-end scripts (the
+# code they run is the unit tests' code, and sanitized it takes several times as long;
+# docs/RELIABILITY.md, Sanitizers); the benchmarks are not built (no test runs them).
+build-sanitize: deps
 	@cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DKEYPLACE_SANITIZE=ON \
 	  -DKEYPLACE_BUILD_BENCHMARKS=OFF \
 	  $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
-	@cd $(SANITIZE_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_SKIP)'
+
+test-sanitize: build-sanitize
+	@cd $(SANITIZE_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) -LE '^slow$$' \
+	  -E '$(SANITIZE_SKIP)'
 
 # The libFuzzer harnesses of tests/fuzz, built with clang, ASan and UBSan in $(FUZZ_DIR) (the
 # library and the harnesses only), each run for FUZZ_SECONDS with seed FUZZ_SEED on a scratch

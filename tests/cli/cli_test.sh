@@ -88,11 +88,7 @@ check "info on map" "$keyplace" info "$work/map.kpm" --json "$work/mapinfo.json"
 check "info map submaps" test "$(json_value "$work/mapinfo.json" submaps)" = "$(json_value "$work/map.json" submaps)"
 check "localize" "$keyplace" localize --map "$work/map.kpm" --log "$log" --n-pos 40 \
   --threads 2 --json "$work/loc.json" --queries "$work/loc.tsv"
-# The queries run in parallel: one thread gives the same figures and rows, times aside.
-check "localize, 1 thread" "$keyplace" localize --map "$work/map.kpm" --log "$log" --n-pos 40 \
-  --threads 1 --json "$work/loc1.json" --queries "$work/loc1.tsv"
-check "localize: same JSON at 1 and 2 threads" same_figures "$work/loc1.json" "$work/loc.json"
-check "localize: same rows at 1 and 2 threads" same_figures "$work/loc1.tsv" "$work/loc.tsv"
+# (The same figures at any thread count: cli.determinism.)
 check "localize json" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
@@ -207,15 +203,18 @@ assert j == defaults, [k for k in j if j[k] != defaults.get(k)]
 fails_with "dump-config --json over its --config" "destroy the input" "$keyplace" dump-config \
   --config "$work/defaults.yaml" --json "$work/defaults.yaml"
 check "dump-config --set" sh -c "'$keyplace' dump-config --set place.ransac.iterations=40 | grep -q '^    iterations: 40 '"
-check "map with the dumped defaults" "$keyplace" map "$log" --config "$work/defaults.yaml" \
-  --out "$work/map-config.kpm"
-check "map byte-identical with --config defaults" cmp "$work/map.kpm" "$work/map-config.kpm"
+# (The first 300 scans: the identity holds or not whatever the length, in a fifth of the time.)
+check "map of 300 scans" "$keyplace" map "$log" --scans 0:300 --out "$work/map-300.kpm"
+check "map with the dumped defaults" "$keyplace" map "$log" --scans 0:300 \
+  --config "$work/defaults.yaml" --out "$work/map-config.kpm"
+check "map byte-identical with --config defaults" cmp "$work/map-300.kpm" "$work/map-config.kpm"
 check "map json records the configuration" python3 -c "
 import json,sys
 j=json.load(open(sys.argv[1]))
 assert j['config']['mapping']['cell_size_m'] == '0.1' and j['config']['place']['ransac']['iterations'] == '18', j['config']" "$work/map.json"
 check "info shows the map's configuration" sh -c "'$keyplace' info '$work/map.kpm' | grep -q '^    inlier_distance_m: 0.1 '"
-"$keyplace" map "$log" --set mapping.min_overlap=0.7 --out "$work/map-07.kpm" >/dev/null
+"$keyplace" map "$log" --scans 0:300 --set mapping.min_overlap=0.7 --out "$work/map-07.kpm" \
+  >/dev/null
 check "info json of a changed map" python3 -c "
 import json,subprocess,sys
 subprocess.run([sys.argv[1], 'info', sys.argv[2], '--json', sys.argv[3]], check=True, capture_output=True)
