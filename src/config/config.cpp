@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "common/shown_text.hpp"
 #include "config/section_tables.hpp"
 
 namespace keyplace {
@@ -194,7 +195,8 @@ std::vector<std::pair<std::string, std::string>> ConfigKeyValues(const Config& c
 
 void SetConfigValue(const std::string& key, const std::string& value, Config& config) {
   const auto* field = ConfigTable().Find(key);
-  if (field == nullptr) throw std::invalid_argument("unknown configuration key '" + key + "'");
+  if (field == nullptr)
+    throw std::invalid_argument("unknown configuration key '" + ShownText(key) + "'");
   try {
     field->set(value, config);
     ValidateSection(key, config);
@@ -206,7 +208,8 @@ void SetConfigValue(const std::string& key, const std::string& value, Config& co
 void ApplyConfigAssignment(const std::string& assignment, Config& config) {
   const auto equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
-    throw std::invalid_argument("--set '" + assignment + "': expected section.key=value");
+    throw std::invalid_argument("--set '" + ShownText(assignment) +
+                                "': expected section.key=value");
   }
   SetConfigValue(assignment.substr(0, equals), assignment.substr(equals + 1), config);
 }

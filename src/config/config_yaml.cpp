@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "io/bounded_read.hpp"
+#include "io/yaml_document.hpp"
 #include "keyplace/config/config.hpp"
 
 namespace keyplace {
@@ -137,23 +139,13 @@ std::string ConfigToYaml(const Config& config) {
 }
 
 void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& error) {
-    throw std::invalid_argument(source + ":" + std::to_string(error.mark.line + 1) +
-                                ": malformed YAML: " + error.msg);
-  }
+  const YAML::Node root = LoadYamlDocument(yaml, source);
   if (root.IsNull()) return;  // an empty file changes nothing
   ApplyNode(root, "", source, config);
 }
 
 void ApplyConfigFile(const std::string& path, Config& config) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open the configuration file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  ApplyConfigYaml(text.str(), path, config);
+  ApplyConfigYaml(ReadWholeFile(path, kMaxConfigFileBytes, "configuration file"), path, config);
 }
 
 }  // namespace keyplace
