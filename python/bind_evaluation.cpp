@@ -27,11 +27,7 @@ LogInputOptions InputOptions(const Config& config, const py::object& scans) {
   options.reading.bag = config.input;
   options.odometry = config.odometry;
   options.features = config.features;
-  if (!scans.is_none()) {
-    const auto range = scans.cast<std::pair<std::size_t, std::size_t>>();
-    options.first_scan = range.first;
-    options.end_scan = range.second;
-  }
+  ApplyScans(scans, options);
   return options;
 }
 

@@ -35,11 +35,7 @@ GlobalMap BuildMap(const std::string& path, const py::object& config, const py::
   options.odometry = resolved.odometry;
   options.features = resolved.features;
   options.start_at_origin = start_at_origin;
-  if (!scans.is_none()) {
-    const auto range = scans.cast<std::pair<std::size_t, std::size_t>>();
-    options.first_scan = range.first;
-    options.end_scan = range.second;
-  }
+  ApplyScans(scans, options);
   py::gil_scoped_release release;
   const LogInputs inputs = PrepareLogInputs(path, options);
   LogMap result = MapLog(inputs, resolved.mapping);
@@ -171,11 +167,14 @@ void BindMap(py::module_& module) {
       .def(
           "save",
           [](const GlobalMap& map, const std::string& path) {
+            CheckPythonOutput(path, {}, map.source_hash);
             py::gil_scoped_release release;
             SaveMap(map, path);
           },
           py::arg("path"),
-          "Writes the map file (.kpm, SQLite) atomically; RuntimeError naming the path on failure.")
+          "Writes the map file (.kpm, SQLite) atomically; RuntimeError naming the path on failure, "
+          "ValueError (nothing written) when the path is the log the map was made from or its "
+          "directory is missing.")
       .def("__repr__", [](const GlobalMap& m) {
         return "<keyplace.Map " + m.source_log + ": " + std::to_string(m.submaps.size()) +
                " submaps, " + std::to_string(m.KeypointCount()) + " keypoints>";

@@ -25,6 +25,7 @@ namespace {
 struct PyGrid {
   OccupancyGrid grid;
   OccupancyGridConfig config;
+  std::string source_path;  // the log or bag it was built from: write_map_server protects it
 };
 
 // H x W array of one value per cell, in the image's order: row 0 is the top (largest y) row.
@@ -65,11 +66,7 @@ PyGrid BuildGrid(const std::string& path, const py::object& config, const py::ob
   options.start_at_origin = start_at_origin;
   options.keypoints = false;               // a grid needs scans and poses only
   options.compute_poses = run == nullptr;  // a SLAM run brings its own
-  if (!scans.is_none()) {
-    const auto range = scans.cast<std::pair<std::size_t, std::size_t>>();
-    options.first_scan = range.first;
-    options.end_scan = range.second;
-  }
+  ApplyScans(scans, options);
   py::gil_scoped_release release;
   const LogInputs inputs = PrepareLogInputs(path, options);
   if (run != nullptr && run->scans != inputs.log.scans.size()) {
@@ -80,6 +77,7 @@ PyGrid BuildGrid(const std::string& path, const py::object& config, const py::ob
   }
   PyGrid grid;
   grid.config = resolved.grid;
+  grid.source_path = path;
   grid.grid = run != nullptr ? SlamOccupancyGrid(*run, inputs, resolved.grid)
                              : LogOccupancyGrid(inputs, resolved.grid);
   return grid;
@@ -131,6 +129,8 @@ void BindGrid(py::module_& module) {
       .def(
           "write_map_server",
           [](const PyGrid& g, const std::string& yaml_path) {
+            CheckPythonOutput(yaml_path, {g.source_path});
+            CheckPythonOutput(MapServerImagePath(yaml_path), {g.source_path});
             py::gil_scoped_release release;
             WriteMapServerMap(g.grid, g.config, yaml_path);
             return MapServerImagePath(yaml_path);
@@ -191,6 +191,7 @@ InitialPose MakeInitialPose(const py::object& pose, const py::object& pose_covar
   if (!pose_covariance.is_none()) {
     initial.covariance = ToCovariance(pose_covariance, "pose_covariance");
   }
+  CheckInitialPoseFrameId(frame_id);  // ValueError, as the docs say
   initial.frame_id = frame_id;
   return initial;
 }
@@ -230,6 +231,7 @@ void BindInitialPose(py::module_& module) {
       .def(
           "write",
           [](const InitialPose& p, const std::string& path) {
+            CheckPythonOutput(path, {});
             py::gil_scoped_release release;
             WriteInitialPose(p, path);
           },

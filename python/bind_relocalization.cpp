@@ -53,11 +53,7 @@ PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
   input_options.poses = ParsePoseSource(poses);
   input_options.odometry = resolved.odometry;
   input_options.features = resolved.features;
-  if (!scans.is_none()) {
-    const auto range = scans.cast<std::pair<std::size_t, std::size_t>>();
-    input_options.first_scan = range.first;
-    input_options.end_scan = range.second;
-  }
+  ApplyScans(scans, input_options);
   const std::string truth_path = TextOrEmpty(truth);
   const std::string index_path = TextOrEmpty(index);
   const GlobalMap global_map = ToMap(map);

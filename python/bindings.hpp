@@ -19,6 +19,7 @@
 #include "keyplace/features/descriptor.hpp"
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/mapping/global_map.hpp"
+#include "keyplace/mapping/scan_sources.hpp"
 
 namespace keyplace::python {
 
@@ -54,6 +55,18 @@ GlobalMap ToMap(const py::object& map);
 /// from whatever thread it works on; the GIL is taken for each call, and an exception the
 /// callable raises ends the work and reaches the caller.
 std::function<void(std::size_t, std::size_t)> ToProgress(const py::object& progress);
+
+/// Sets options.first_scan / end_scan from a `scans` argument: None (every scan) or a pair
+/// (first, end) of non-negative integers with first <= end; ValueError naming the argument
+/// otherwise (formerly pybind11's "Unable to cast").
+void ApplyScans(const py::object& scans, LogInputOptions& options);
+
+/// The CLI's protection of inputs (CheckNotAnInput, io/atomic_file.hpp) for a Python writer:
+/// `path` must be none of `inputs` under any name; with `source_fingerprint` (a map's
+/// source_hash) it must not be the log or bag of that content either. ValueError otherwise,
+/// before anything is written.
+void CheckPythonOutput(const std::string& path, const std::vector<std::string>& inputs,
+                       const std::string& source_fingerprint = "");
 
 /// [x, y, theta] (m, m, rad).
 py::array_t<double> PoseArray(const Pose2& pose);

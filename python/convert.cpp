@@ -1,6 +1,7 @@
 // Conversions between the library's types and numpy arrays, and configuration from Python.
 
 #include <algorithm>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -10,6 +11,8 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "io/atomic_file.hpp"
+#include "io/file_fingerprint.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/store/map_file.hpp"
 
@@ -60,6 +63,52 @@ PyConfig ResolveConfig(const py::object& config, const py::object& overrides) {
   AddOverrides(overrides, builder);
   resolved.config = builder.Build();
   return resolved;
+}
+
+void ApplyScans(const py::object& scans, LogInputOptions& options) {
+  if (scans.is_none()) return;
+  const auto refuse = [&] {
+    std::string shown = py::repr(scans).cast<std::string>();
+    if (shown.size() > 60) shown = shown.substr(0, 60) + "...";
+    throw py::value_error("scans=" + shown +
+                          ": expected (first, end), two integers with 0 <= first <= end");
+  };
+  if (py::isinstance<py::str>(scans) || py::isinstance<py::bytes>(scans) ||
+      !py::isinstance<py::sequence>(scans)) {
+    refuse();
+  }
+  const auto sequence = scans.cast<py::sequence>();
+  if (sequence.size() != 2) refuse();
+  long long bounds[2] = {0, 0};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const py::object item = sequence[i];
+    if (py::isinstance<py::bool_>(item) || !py::isinstance<py::int_>(item)) refuse();
+    try {
+      bounds[i] = item.cast<long long>();
+    } catch (const py::cast_error&) {
+      refuse();
+    }
+  }
+  if (bounds[0] < 0 || bounds[1] < bounds[0]) refuse();
+  options.first_scan = static_cast<std::size_t>(bounds[0]);
+  options.end_scan = static_cast<std::size_t>(bounds[1]);
+}
+
+void CheckPythonOutput(const std::string& path, const std::vector<std::string>& inputs,
+                       const std::string& source_fingerprint) {
+  // std::invalid_argument: ValueError. A missing directory stays the write's RuntimeError.
+  CheckNotAnInput(path, inputs);
+  if (source_fingerprint.empty()) return;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return;
+  // Only a file of the source's size can be it: the size is the fingerprint's last field.
+  const std::string size = std::to_string(std::filesystem::file_size(path, error));
+  const std::size_t colon = source_fingerprint.rfind(':');
+  if (error || colon == std::string::npos || source_fingerprint.substr(colon + 1) != size) return;
+  if (FileFingerprint(path) == source_fingerprint) {
+    throw py::value_error(path + ": is the log the map was made from (" + source_fingerprint +
+                          "); writing it would destroy the input");
+  }
 }
 
 GlobalMap ToMap(const py::object& map) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -63,8 +64,29 @@ void WriteJson(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }
 
-void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
-                  const std::vector<std::string>& inputs) {
+namespace {
+
+// Every value given to `command`'s options and positionals but those of `outputs`.
+std::vector<std::string> GivenInputs(
+    const CLI::App& command, const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<std::string> inputs;
+  for (const CLI::Option* option : command.get_options()) {
+    const bool is_output = std::any_of(outputs.begin(), outputs.end(), [&](const auto& output) {
+      return output.first.rfind("--", 0) == 0 && option->check_name(output.first);
+    });
+    if (is_output || option->get_type_size_max() == 0) continue;  // an output, or a flag
+    for (const std::string& value : option->results()) inputs.push_back(value);
+  }
+  return inputs;
+}
+
+}  // namespace
+
+void CheckOutputs(const CLI::App& command,
+                  const std::vector<std::pair<std::string, std::string>>& outputs,
+                  const std::vector<std::string>& more_inputs) {
+  std::vector<std::string> inputs = GivenInputs(command, outputs);
+  inputs.insert(inputs.end(), more_inputs.begin(), more_inputs.end());
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const auto& [option, path] = outputs[i];
     if (path.empty()) continue;

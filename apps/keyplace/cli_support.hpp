@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "keyplace/eval/grid_agreement.hpp"
@@ -62,10 +63,14 @@ struct ScanRange {
 };
 ScanRange ParseScanRange(const std::string& text, std::size_t count);
 
-/// CheckOutputPath on every given output (option name, path; empty paths are skipped), and no two
-/// outputs the same file: throws std::invalid_argument naming the option, before any work.
-void CheckOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
-                  const std::vector<std::string>& inputs);
+/// The one check every command that writes runs before any work: CheckOutputPath on every given
+/// output (option name, path; empty paths are skipped) against the inputs, and no two outputs the
+/// same file; throws std::invalid_argument naming the option. The inputs are every value given
+/// on the command line to `command` (positionals included) except to the outputs' own options,
+/// so that no input can be forgotten, plus `more_inputs` (files named elsewhere).
+void CheckOutputs(const CLI::App& command,
+                  const std::vector<std::pair<std::string, std::string>>& outputs,
+                  const std::vector<std::string>& more_inputs = {});
 
 /// Refuses `path` (given to `option`) when it names one of `reserved`, the files a command keeps
 /// in its own output directory (a sweep's resume identity, a report's page), whether they exist

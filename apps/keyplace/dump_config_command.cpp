@@ -22,8 +22,8 @@ void RegisterDumpConfigCommand(CLI::App& app) {
   command->add_option("--json", *json_path,
                       "Also write the configuration as JSON to FILE (the \"config\" object the "
                       "other commands' --json carries)");
-  command->callback([options, json_path] {
-    CheckOutputs({{"--json", *json_path}}, {options->file});
+  command->callback([command, options, json_path] {
+    CheckOutputs(*command, {{"--json", *json_path}});
     const Config config = ResolveConfig(*options);
     std::cout << ConfigToYaml(config);
     if (!json_path->empty()) WriteJson(*json_path, ConfigJson(config));

@@ -29,7 +29,8 @@ struct FeaturesOptions {
   ConfigOptions config;
 };
 
-void RunFeatures(const FeaturesOptions& options) {
+void RunFeatures(const CLI::App& command, const FeaturesOptions& options) {
+  CheckOutputs(command, {{"--tsv", options.tsv_path}, {"--json", options.json_path}});
   const Config config = ResolveConfig(options.config);
   const CarmenLog log = ReadLogWithScans(options.input, ReadingOptions(config));
   const ScanRange range = ParseScanRange(options.scans, log.scans.size());
@@ -136,7 +137,7 @@ void RegisterFeaturesCommand(CLI::App& app) {
                       "m, rad; scale = 2 sigma of the detection level)");
   command->add_option("--json", options->json_path, "Write the statistics as JSON to FILE");
   AddConfigOptions(command, options->config);
-  command->callback([options] { RunFeatures(*options); });
+  command->callback([command, options] { RunFeatures(*command, *options); });
 }
 
 }  // namespace keyplace::cli

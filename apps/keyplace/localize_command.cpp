@@ -83,18 +83,12 @@ GlobalMap WithDistractors(const GlobalMap& map, const std::vector<std::string>& 
   return EmbedAmongDistractors(map, sources, distractors);
 }
 
-void RunLocalize(const LocalizeOptions& options) {
+void RunLocalize(const CLI::App& command, const LocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::string> input_paths = {options.query.log_path, options.query.truth_path,
-                                          options.query.index_path, options.map_path,
-                                          options.config.file};
-  input_paths.insert(input_paths.end(), options.distractor_paths.begin(),
-                     options.distractor_paths.end());
-  CheckOutputs({{"--json", options.json_path},
-                {"--queries", options.queries_path},
-                {"--curve", options.curve_path},
-                {"--reliability", options.reliability_path}},
-               input_paths);
+  CheckOutputs(command, {{"--json", options.json_path},
+                         {"--queries", options.queries_path},
+                         {"--curve", options.curve_path},
+                         {"--reliability", options.reliability_path}});
   const bool baseline = !options.baseline.empty();
   if (!baseline && options.map_path.empty()) {
     throw std::invalid_argument("--map is required (except with --baseline tip-flirt)");
@@ -289,8 +283,9 @@ void RegisterLocalizeCommand(CLI::App& app) {
   command->add_option("--reliability", options->reliability_path,
                       "Write the reliability diagram (TSV): accepted answers in 10 confidence "
                       "bins, mean confidence and observed precision per bin");
-  command->callback(
-      [options] { RunOnWorkerThreads(options->query.threads, [&] { RunLocalize(*options); }); });
+  command->callback([command, options] {
+    RunOnWorkerThreads(options->query.threads, [&] { RunLocalize(*command, *options); });
+  });
 }
 
 }  // namespace keyplace::cli

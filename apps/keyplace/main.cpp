@@ -50,8 +50,16 @@ int Run(int argc, char** argv) {
   if (argc > 1 && UnknownCommand(app, argv[1])) return 1;
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& error) {
+    return error.get_exit_code();  // a command that printed its own failure (report)
   } catch (const CLI::ParseError& error) {
-    return app.exit(error);
+    // --help and --version end here with status 0. A usage error (a missing path, an unknown
+    // option) is an error like any other: the same prefix and exit status 1, not CLI11's codes
+    // (105 for a missing file).
+    if (error.get_exit_code() == 0) return app.exit(error);
+    std::fprintf(stderr, "keyplace: error: %s\nRun with --help for more information.\n",
+                 error.what());
+    return 1;
   }
   return 0;
 }

@@ -142,14 +142,14 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   return json;
 }
 
-void RunMap(const MapOptions& options) {
+void RunMap(const CLI::App& command, const MapOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   auto outputs = GridOutputs(options.grid_path);
   outputs.insert(outputs.end(), {{"--out", options.out_path},
                                  {"--json", options.json_path},
                                  {"--png", options.png_path},
                                  {"--svg", options.svg_path}});
-  CheckOutputs(outputs, {options.input, options.config.file});
+  CheckOutputs(command, outputs);
   const Config config = ResolveConfig(options.config, [&](Config& c) {
     if (options.overlap_only) {
       c.mapping.use_distribution = false;
@@ -231,7 +231,9 @@ void RegisterMapCommand(CLI::App& app) {
                    "depend on it")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  command->callback([options] { RunOnWorkerThreads(options->threads, [&] { RunMap(*options); }); });
+  command->callback([command, options] {
+    RunOnWorkerThreads(options->threads, [&] { RunMap(*command, *options); });
+  });
 }
 
 }  // namespace keyplace::cli

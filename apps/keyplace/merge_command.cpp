@@ -139,11 +139,9 @@ nlohmann::json MergeJson(const MergeCommandOptions& options, const MergeResult& 
   return json;
 }
 
-void RunMerge(const MergeCommandOptions& options) {
+void RunMerge(const CLI::App& command, const MergeCommandOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--out", options.out_path}, {"--json", options.json_path}},
-               {options.map_a, options.map_b, options.log_path, options.truth_path,
-                options.index_path, options.config.file});
+  CheckOutputs(command, {{"--out", options.out_path}, {"--json", options.json_path}});
   if (options.log_path.empty() && !(options.truth_path.empty() && options.index_path.empty())) {
     throw std::invalid_argument("--truth and --index need --log (the log the maps were made from)");
   }
@@ -226,7 +224,7 @@ void RegisterMergeCommand(CLI::App& app) {
   // Joining maps acts on the answer as a robot would: the strict preset (see relocalize).
   options->config.preset = "strict";
   AddConfigOptions(command, options->config);
-  command->callback([options] { RunMerge(*options); });
+  command->callback([command, options] { RunMerge(*command, *options); });
 }
 
 }  // namespace keyplace::cli

@@ -41,13 +41,11 @@ struct OdometryOptions {
   ConfigOptions config;
 };
 
-void RunOdometry(const OdometryOptions& options) {
-  CheckOutputs({{"--out", options.out_path},
-                {"--relation-errors", options.relation_errors_path},
-                {"--steps", options.steps_path},
-                {"--json", options.json_path}},
-               {options.input, options.relations_path, options.corrected_path, options.index_path,
-                options.config.file});
+void RunOdometry(const CLI::App& command, const OdometryOptions& options) {
+  CheckOutputs(command, {{"--out", options.out_path},
+                         {"--relation-errors", options.relation_errors_path},
+                         {"--steps", options.steps_path},
+                         {"--json", options.json_path}});
   std::vector<std::string> aliases;
   if (!options.local_dt.empty()) {
     aliases.push_back("evaluation.local_relation_max_dt_s=" + options.local_dt);
@@ -60,6 +58,7 @@ void RunOdometry(const OdometryOptions& options) {
   const CarmenLog log = ReadLogWithScans(options.input, ReadingOptions(config));
   OdometryRunOptions run_options;
   run_options.order = ParseScanOrder(options.order);
+  run_options.source = log.path;
   ScanRange range{0, log.scans.size()};
   if (!options.scans.empty()) range = ParseScanRange(options.scans, log.scans.size());
   run_options.begin = range.begin;
@@ -186,7 +185,7 @@ void RegisterOdometryCommand(CLI::App& app) {
                       "relations with |t_b - t_a| below this (s) are local, the others loop; "
                       "short for --set evaluation.local_relation_max_dt_s=SECONDS (default 5)");
   AddConfigOptions(command, options->config);
-  command->callback([options] { RunOdometry(*options); });
+  command->callback([command, options] { RunOdometry(*command, *options); });
 }
 
 }  // namespace keyplace::cli

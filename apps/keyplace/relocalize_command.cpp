@@ -50,15 +50,13 @@ void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
              first->start_scan, first->fix.scan, path);
 }
 
-void RunRelocalize(const RelocalizeOptions& options) {
+void RunRelocalize(const CLI::App& command, const RelocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckOutputs({{"--json", options.json_path},
-                {"--tsv", options.tsv_path},
-                {"--fixes", options.fixes_path},
-                {"--figure", options.figure_path},
-                {"--initialpose", options.initial_pose_path}},
-               {options.query.log_path, options.query.truth_path, options.query.index_path,
-                options.map_path, options.config.file});
+  CheckOutputs(command, {{"--json", options.json_path},
+                         {"--tsv", options.tsv_path},
+                         {"--fixes", options.fixes_path},
+                         {"--figure", options.figure_path},
+                         {"--initialpose", options.initial_pose_path}});
   if (options.starts < 1) throw std::invalid_argument("--starts must be >= 1");
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);
@@ -149,8 +147,9 @@ void RegisterRelocalizeCommand(CLI::App& app) {
   command->add_option("--initialpose", options->initial_pose_path,
                       "Write the first fix as a geometry_msgs/PoseWithCovarianceStamped for "
                       "/initialpose (YAML, or JSON for a .json FILE), in the map's frame");
-  command->callback(
-      [options] { RunOnWorkerThreads(options->query.threads, [&] { RunRelocalize(*options); }); });
+  command->callback([command, options] {
+    RunOnWorkerThreads(options->query.threads, [&] { RunRelocalize(*command, *options); });
+  });
 }
 
 }  // namespace keyplace::cli

@@ -57,10 +57,10 @@ nlohmann::json ReportJson(const ReportOptions& options, const ReportSummary& sum
   return json;
 }
 
-int Report(ReportOptions options, const std::string& json_path) {
+int Report(const CLI::App& command, ReportOptions options, const std::string& json_path) {
   const auto start = std::chrono::steady_clock::now();
   if (options.data_dir.empty()) options.data_dir = DefaultDataDir();
-  CheckOutputs({{"--json", json_path}}, {});
+  CheckOutputs(command, {{"--json", json_path}});
   CheckNotReserved("--json", json_path, {options.out_dir + "/index.html"}, "the report's page");
   // This very executable, even if its file is replaced by a rebuild while the report runs.
   const ReportSummary summary = RunReport(options, "/proc/self/exe");
@@ -117,8 +117,8 @@ void RegisterReportCommand(CLI::App& app) {
       ->add_option("--stability-scan", options->stability_scan,
                    "First scan of the submap drawn in Figures 6-7")
       ->capture_default_str();
-  command->callback([options, json_path] {
-    const int status = Report(*options, *json_path);
+  command->callback([command, options, json_path] {
+    const int status = Report(*command, *options, *json_path);
     if (status != 0) throw CLI::RuntimeError(status);
   });
 }

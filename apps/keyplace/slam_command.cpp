@@ -61,7 +61,7 @@ SlamRun Run(const LogInputs& inputs, const Config& config, ProcessingOrder order
   return run;
 }
 
-void RunSlam(const SlamOptions& options) {
+void RunSlam(const CLI::App& command, const SlamOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (options.truth_path.empty() != options.index_path.empty()) {
     throw std::invalid_argument("--truth and --index must be given together");
@@ -71,8 +71,7 @@ void RunSlam(const SlamOptions& options) {
                                  {"--trajectory", options.trajectory_path},
                                  {"--json", options.json_path},
                                  {"--loops", options.loops_path}});
-  CheckOutputs(outputs, {options.input, options.truth_path, options.index_path,
-                         options.relations_path, options.config.file});
+  CheckOutputs(command, outputs);
   const Config config = ResolveConfig(options.config);
   const ProcessingOrder order = ParseProcessingOrder(options.order);
   const LogInputs inputs = PrepareInputs(options.input, config);
@@ -177,7 +176,7 @@ void RegisterSlamCommand(CLI::App& app) {
   command->add_option("--order", options->order, "processing order: logger (default) or file")
       ->check(CLI::IsMember({"logger", "file"}));
   AddConfigOptions(command, options->config);
-  command->callback([options] { RunSlam(*options); });
+  command->callback([command, options] { RunSlam(*command, *options); });
 }
 
 }  // namespace keyplace::cli

@@ -108,17 +108,17 @@ Config ResolveSweepConfig(const SweepOptions& options) {
 
 // The JSON must not be the log, nor one of the files the sweep keeps in --out (its resume
 // identity and results), which it would replace.
-void CheckSweepOutputs(const SweepOptions& options) {
-  CheckOutputs({{"--json", options.json_path}}, {options.log_path});
+void CheckSweepOutputs(const CLI::App& command, const SweepOptions& options) {
+  CheckOutputs(command, {{"--json", options.json_path}});
   const std::string dir = options.out_dir;
   CheckNotReserved("--json", options.json_path,
                    {dir + "/sweep.json", dir + "/results.csv", dir + "/results.json"},
                    "the sweep's own file");
 }
 
-void RunSweepMapping(const SweepOptions& options) {
+void RunSweepMapping(const CLI::App& command, const SweepOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckSweepOutputs(options);
+  CheckSweepOutputs(command, options);
   const std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                                    {"l_g", ParseValueList(options.l_g, "--lg")}};
   const std::vector<std::vector<double>> grid = ExpandGrid(axes);
@@ -153,9 +153,9 @@ void RunSweepMapping(const SweepOptions& options) {
                  SecondsSince(start));
 }
 
-void RunSweepPlace(const SweepOptions& options) {
+void RunSweepPlace(const CLI::App& command, const SweepOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  CheckSweepOutputs(options);
+  CheckSweepOutputs(command, options);
   if (options.n_pos < 1) throw std::invalid_argument("--n-pos must be >= 1");
   std::vector<GridAxis> axes{{"s_min", ParseValueList(options.s_min, "--s-min")},
                              {"l_g", ParseValueList(options.l_g, "--lg")},
@@ -261,8 +261,9 @@ void RegisterSweepCommand(CLI::App& app) {
   mapping_command->add_flag("--overlap-only", mapping->overlap_only,
                             "Complete submaps on the overlap criterion alone (as keyplace map)");
   AddCommonOptions(mapping_command, *mapping);
-  mapping_command->callback(
-      [mapping] { RunOnWorkerThreads(mapping->threads, [&] { RunSweepMapping(*mapping); }); });
+  mapping_command->callback([mapping_command, mapping] {
+    RunOnWorkerThreads(mapping->threads, [&] { RunSweepMapping(*mapping_command, *mapping); });
+  });
 
   auto place = std::make_shared<SweepOptions>();
   CLI::App* place_command = sweep->add_subcommand(
@@ -283,8 +284,9 @@ void RegisterSweepCommand(CLI::App& app) {
   place_command->add_flag("--exclude-shared-scans", place->exclude_shared_scans,
                           "Skip every map submap sharing a scan with the query");
   AddCommonOptions(place_command, *place);
-  place_command->callback(
-      [place] { RunOnWorkerThreads(place->threads, [&] { RunSweepPlace(*place); }); });
+  place_command->callback([place_command, place] {
+    RunOnWorkerThreads(place->threads, [&] { RunSweepPlace(*place_command, *place); });
+  });
 }
 
 }  // namespace keyplace::cli

@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/shown_text.hpp"
+
 namespace keyplace {
 
 /// The shortest text that reads back as the same double.
@@ -51,7 +53,8 @@ class ConfigFields {
           const double value = ParseNumber<double>(text, "a number");
           // No setting means "unlimited" by infinity (0 switches things off), and an infinite
           // size or distance would only fail later, as an allocation or a NaN far from here.
-          if (!std::isfinite(value)) throw std::invalid_argument("'" + text + "' is not finite");
+          if (!std::isfinite(value))
+            throw std::invalid_argument("'" + ShownText(text) + "' is not finite");
           c.*member = value;
         });
   }
@@ -82,7 +85,7 @@ class ConfigFields {
           } else if (text == "false" || text == "0") {
             c.*member = false;
           } else {
-            throw std::invalid_argument("'" + text + "' is not true or false");
+            throw std::invalid_argument("'" + ShownText(text) + "' is not true or false");
           }
         });
   }
@@ -108,7 +111,7 @@ class ConfigFields {
               return;
             }
           }
-          throw std::invalid_argument("'" + text + "' is not one of " + values);
+          throw std::invalid_argument("'" + ShownText(text) + "' is not one of " + values);
         });
   }
 
@@ -140,7 +143,7 @@ class ConfigFields {
   void Set(const std::string& key, const std::string& text, Config& config) const {
     const Field* field = Find(key);
     if (field == nullptr) {
-      throw std::invalid_argument(struct_name_ + ": unknown key '" + key + "'");
+      throw std::invalid_argument(struct_name_ + ": unknown key '" + ShownText(key) + "'");
     }
     try {
       field->set(text, config);
@@ -175,7 +178,7 @@ class ConfigFields {
     const char* end = text.data() + text.size();
     const auto result = std::from_chars(begin, end, value);
     if (text.empty() || result.ec != std::errc() || result.ptr != end) {
-      throw std::invalid_argument("'" + text + "' is not " + kind);
+      throw std::invalid_argument("'" + ShownText(text) + "' is not " + kind);
     }
     return value;
   }

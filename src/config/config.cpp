@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/shown_text.hpp"
 #include "config/section_tables.hpp"
 #include "config/spelling.hpp"
 
@@ -287,13 +288,13 @@ ConfigBuilder& ConfigBuilder::Set(const std::string& key, const std::string& val
     } catch (const std::invalid_argument& error) {
       throw std::invalid_argument(where + error.what());
     }
-    throw std::invalid_argument(where + "unknown configuration key '" + key + "'" +
+    throw std::invalid_argument(where + "unknown configuration key '" + ShownText(key) + "'" +
                                 DidYouMean(key, ConfigKeys()));
   }
   try {
     field->set(value, config_);
   } catch (const std::invalid_argument& error) {
-    throw std::invalid_argument(where + key + ": " + error.what());
+    throw std::invalid_argument(where + ShownText(key) + ": " + error.what());
   }
   given_.emplace_back(key + "=" + value, origin);
   return *this;
@@ -302,7 +303,8 @@ ConfigBuilder& ConfigBuilder::Set(const std::string& key, const std::string& val
 ConfigBuilder& ConfigBuilder::Assign(const std::string& assignment, const std::string& origin) {
   const auto equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
-    throw std::invalid_argument("--set '" + assignment + "': expected section.key=value");
+    throw std::invalid_argument("--set '" + ShownText(assignment) +
+                                "': expected section.key=value");
   }
   return Set(assignment.substr(0, equals), assignment.substr(equals + 1), origin);
 }

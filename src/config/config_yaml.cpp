@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "io/bounded_read.hpp"
+#include "io/yaml_document.hpp"
 #include "keyplace/config/config.hpp"
 
 namespace keyplace {
@@ -133,23 +135,13 @@ std::string ConfigToYaml(const Config& config) {
 }
 
 ConfigBuilder& ConfigBuilder::Yaml(const std::string& yaml, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& error) {
-    throw std::invalid_argument(source + ":" + std::to_string(error.mark.line + 1) +
-                                ": malformed YAML: " + error.msg);
-  }
+  const YAML::Node root = LoadYamlDocument(yaml, source);
   if (!root.IsNull()) ApplyNode(root, "", source, *this);  // an empty file changes nothing
   return *this;
 }
 
 ConfigBuilder& ConfigBuilder::File(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open the configuration file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return Yaml(text.str(), path);
+  return Yaml(ReadWholeFile(path, kMaxConfigFileBytes, "configuration file"), path);
 }
 
 void ApplyConfigYaml(const std::string& yaml, const std::string& source, Config& config) {

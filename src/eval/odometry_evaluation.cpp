@@ -91,7 +91,8 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
     const bool logger = options.order == ScanOrder::kLogger;
     RequireTimeOrder(
         CheckTimestamps(scans, logger ? TimestampSource::kLogger : TimestampSource::kIpc),
-        logger ? "the logger timestamps" : "the ipc timestamps");
+        (options.source.empty() ? "" : options.source + ": ") +
+            (logger ? "the logger timestamps" : "the ipc timestamps"));
   }
   const std::vector<std::size_t> order = ProcessingOrder(scans, options.order);
   const std::size_t end = std::min(options.end, order.size());

@@ -96,12 +96,30 @@ void CheckOutputPath(const std::string& path, const std::vector<std::string>& in
                                 " is not writable");
   }
   if (fs::is_directory(target, error)) throw std::invalid_argument(path + ": is a directory");
+  CheckNotAnInput(path, inputs);
+}
+
+void CheckNotAnInput(const std::string& path, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path directory = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code error;
   if (!fs::exists(target, error)) return;
   for (const std::string& input : inputs) {
-    if (!input.empty() && fs::equivalent(target, fs::path(input), error)) {
+    if (input.empty()) continue;
+    const fs::path source(input);
+    if (fs::equivalent(target, source, error)) {
       std::string message = path;
       message += ": is the input " + input;
       message += "; writing it would destroy the input";
+      throw std::invalid_argument(message);
+    }
+    // A rosbag2 directory is read through the files in it (metadata.yaml, its storage files).
+    if (fs::is_directory(source, error) && fs::exists(source / "metadata.yaml", error) &&
+        fs::equivalent(directory, source, error)) {
+      std::string message = path;
+      message += ": is a file of the input bag directory " + input;
+      message += "; writing it would damage the input";
       throw std::invalid_argument(message);
     }
   }

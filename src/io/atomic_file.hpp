@@ -23,8 +23,14 @@ std::string TemporaryPathFor(const std::string& path);
 void CommitTemporary(const std::string& temporary, const std::string& path);
 
 /// Checks, before any work, that `path` can be written: its directory exists and is writable, it
-/// is not a directory, and it is none of `inputs` (the same file under any name, as an output
-/// would replace the input it is computed from). Throws std::invalid_argument naming the path.
+/// is not a directory, and it is none of `inputs` (the same file under any name: hard link,
+/// symbolic link, ./name, as an output would replace the input it is computed from) nor an
+/// existing file of an input that is a rosbag2 directory. Every writer of the CLI and of the
+/// Python module checks here. Throws std::invalid_argument naming the path and the input.
 void CheckOutputPath(const std::string& path, const std::vector<std::string>& inputs);
+
+/// The part of CheckOutputPath that protects the inputs: `path`, when it exists, is none of
+/// `inputs` under any name, nor a file of an input rosbag2 directory. std::invalid_argument.
+void CheckNotAnInput(const std::string& path, const std::vector<std::string>& inputs);
 
 }  // namespace keyplace

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "common/shown_text.hpp"
 #include "io/pose_track.hpp"
 
 namespace keyplace {
@@ -17,10 +18,17 @@ constexpr double kLongOdometryGapS = 1.0;
 
 std::string TopicList(const BagSummary& summary) {
   if (summary.topics.empty()) return "no topics";
+  // Bounded: names come from the bag, and a message must not grow with them.
+  constexpr std::size_t kShown = 20;
   std::string text;
+  std::size_t shown = 0;
   for (const LogTopic& topic : summary.topics) {
-    text += (text.empty() ? "" : ", ") + topic.name + " (" + topic.type + ", " +
-            std::to_string(topic.messages) + ")";
+    if (shown++ == kShown) {
+      text += ", and " + std::to_string(summary.topics.size() - kShown) + " more";
+      break;
+    }
+    text += (text.empty() ? "" : ", ") + ShownText(topic.name) + " (" + ShownText(topic.type) +
+            ", " + std::to_string(topic.messages) + ")";
   }
   return text;
 }
@@ -114,7 +122,7 @@ class PoseAssembler {
         const std::string& frame = contents_.scan_frames[i];
         const auto T_base_laser = contents_.tf.Lookup(config_.base_frame, frame, scan.timestamp_s);
         if (!T_base_laser) {
-          Fail("no transform " + config_.base_frame + " -> " + NormalizeFrame(frame) +
+          Fail("no transform " + config_.base_frame + " -> " + ShownText(NormalizeFrame(frame)) +
                " (the frame of scan " + std::to_string(i + 1) + " on " + config_.scan_topic +
                ") in /tf_static or /tf (" + contents_.tf.Describe() +
                "); give the laser pose on the robot: --laser-pose x,y,theta (input.laser_pose)");

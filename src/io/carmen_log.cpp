@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/shown_text.hpp"
 #include "io/file_fingerprint.hpp"
 #include "io/ros2_storage.hpp"
 #include "io/sqlite_magic.hpp"
@@ -70,6 +71,9 @@ class LineReader {
                                   ": a ROS 2 MCAP file through a pipe or device: give the bag as "
                                   "a regular file or a rosbag2 directory");
     }
+    RefuseDamagedMagic(kBagMagic, "ROS 1 bag", 3);
+    RefuseDamagedMagic(kMcapMagic, "ROS 2 MCAP file", 2);
+    RefuseDamagedMagic(kSqliteMagic, "SQLite database (keyplace map or rosbag2 .db3)", 3);
     gzip_ = StartsWithGzipMagic();
     if (gzip_) StartInflating();
   }
@@ -157,6 +161,23 @@ class LineReader {
     }
     while (raw_end_ < count && ReadRaw(raw_end_) > 0) {
     }
+  }
+
+  // A file whose first bytes are a bag's or database's magic but for up to `allowed` bytes is
+  // that file damaged, not a log: read as a log it only said "no laser scans ... is this a CARMEN
+  // log?". No CARMEN log begins so (its lines are text: a type name or a '#' comment).
+  void RefuseDamagedMagic(std::string_view magic, const char* kind, std::size_t allowed) {
+    EnsureRaw(magic.size());
+    if (raw_end_ < magic.size()) return;
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < magic.size(); ++i)
+      differing += raw_[i] != static_cast<unsigned char>(magic[i]) ? 1 : 0;
+    if (differing == 0 || differing > allowed) return;
+    const std::string_view head(reinterpret_cast<const char*>(raw_.data()), magic.size());
+    throw std::invalid_argument(path_ + ": a damaged " + kind + ": its first bytes are '" +
+                                ShownText(head) + "', not the magic '" + ShownText(magic) + "' (" +
+                                std::to_string(differing) + " of " + std::to_string(magic.size()) +
+                                " bytes differ); not read");
   }
 
   bool StartsWithRaw(std::string_view magic) {
@@ -299,7 +320,8 @@ class FieldParser {
   // A number that must be finite.
   double Number(std::size_t index, const std::string& field) const {
     const double value = AnyNumber(index, field);
-    if (!std::isfinite(value)) Fail("field '" + field + "' is not finite: '" + Token(index) + "'");
+    if (!std::isfinite(value))
+      Fail("field '" + field + "' is not finite: '" + ShownText(Token(index)) + "'");
     return value;
   }
 
@@ -307,7 +329,7 @@ class FieldParser {
   double Coordinate(std::size_t index, const std::string& field) const {
     const double value = Number(index, field);
     if (!(std::abs(value) <= max_coordinate_m_)) {
-      Fail("field '" + field + "' = " + Token(index) + " m lies beyond +-" +
+      Fail("field '" + field + "' = " + ShownText(Token(index)) + " m lies beyond +-" +
            FormatNumber(max_coordinate_m_) + " m (CarmenReadOptions::max_coordinate_m)");
     }
     return value;
@@ -317,7 +339,8 @@ class FieldParser {
   double Angle(std::size_t index, const std::string& field) const {
     const double value = Number(index, field);
     if (!(std::abs(value) <= 2.0 * M_PI)) {
-      Fail("field '" + field + "' = " + Token(index) + " rad is not an angle in [-2 pi, 2 pi]");
+      Fail("field '" + field + "' = " + ShownText(Token(index)) +
+           " rad is not an angle in [-2 pi, 2 pi]");
     }
     return value;
   }
@@ -332,7 +355,7 @@ class FieldParser {
     if (begin != end && *begin == '+') ++begin;
     const auto result = std::from_chars(begin, end, value);
     if (result.ec != std::errc() || result.ptr != end) {
-      Fail("field '" + field + "' is not a number: '" + std::string(token) + "'");
+      Fail("field '" + field + "' is not a number: '" + ShownText(token) + "'");
     }
     return value;
   }
@@ -343,7 +366,7 @@ class FieldParser {
     long value = 0;
     const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
     if (result.ec != std::errc() || result.ptr != token.data() + token.size()) {
-      Fail("field '" + field + "' is not an integer: '" + std::string(token) + "'");
+      Fail("field '" + field + "' is not an integer: '" + ShownText(token) + "'");
     }
     return value;
   }
@@ -416,9 +439,10 @@ void ClassifyBeams(LaserScan& scan, CarmenLog& log) {
 }
 
 // The PARAMs that give FLASER/RLASER lines their angles: a number there must be a finite angle
-// in (0, 360] degrees (an infinite field of view made every beam angle NaN). A value that is no
-// number, zero or negative keeps being ignored (the defaults apply). Returns the PARAM's laser and
-// value when it is one of them, to be recorded once the line is accepted.
+// in (0, 360] degrees (an infinite field of view made every beam angle NaN; NaN is refused
+// likewise). A value that is no number, zero or negative keeps being ignored (the defaults apply).
+// Returns the PARAM's laser and value when it is one of them, to be recorded once the line is
+// accepted.
 std::optional<std::pair<GeometryParam, std::string>> LaserGeometryParam(const FieldParser& fields,
                                                                         std::size_t line) {
   const std::string name = fields.Token(1);
@@ -431,9 +455,11 @@ std::optional<std::pair<GeometryParam, std::string>> LaserGeometryParam(const Fi
   param.line = line;
   const auto result =
       std::from_chars(param.token.data(), param.token.data() + param.token.size(), param.value);
+  // NaN is refused as infinity is: it is a number, and not an angle.
+  const bool nan = result.ec == std::errc() && std::isnan(param.value);
   if (result.ec != std::errc() || !(param.value > 0.0)) param.value = 0.0;  // ignored
-  if (!(param.value <= 360.0)) {
-    fields.Fail(name + " = '" + param.token + "' is not an angle in (0, 360] degrees");
+  if (nan || !(param.value <= 360.0)) {
+    fields.Fail(name + " = '" + ShownText(param.token) + "' is not an angle in (0, 360] degrees");
   }
   return std::make_pair(param, name);
 }

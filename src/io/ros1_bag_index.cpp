@@ -112,6 +112,16 @@ class IndexReader {
     if (index_offset == 0) throw BagIndexError("the bag header gives no index (index_pos 0)");
     const std::uint32_t connection_count = U32(header.fields, "conn_count", "the bag header");
     const std::uint32_t chunk_count = U32(header.fields, "chunk_count", "the bag header");
+    // A header that counts other chunks than the file holds (chunk_count 0 read as "no topics")
+    // is damaged: the chunks are walked instead, with the warning of a missing index.
+    const auto chunks_in_file = static_cast<std::uint64_t>(std::count_if(
+        records_.begin(), records_.end(),
+        [](const auto& record) { return FieldOp(record.second.fields) == kOpChunk; }));
+    if (chunks_in_file != chunk_count) {
+      throw BagIndexError("the bag header counts " + std::to_string(chunk_count) +
+                          " chunks (chunk_count), the file holds " +
+                          std::to_string(chunks_in_file));
+    }
 
     // The index's records lie one after the other from index_pos.
     std::uint64_t offset = index_offset;

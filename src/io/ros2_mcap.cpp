@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "common/shown_text.hpp"
 #include "io/chunk_limits.hpp"
 #include "io/ros2_storage.hpp"
 
@@ -269,10 +270,11 @@ class McapWalker {
       }
       const auto schema = schema_names_.find(schema_id);
       if (schema_id != 0 && schema == schema_names_.end()) {
-        Fail(offset, "channel " + topic.name + " names schema " + std::to_string(schema_id) +
-                         ", which no Schema record before it declares");
+        Fail(offset, "channel " + ShownText(topic.name) + " names schema " +
+                         std::to_string(schema_id) + ", which no Schema record before it declares");
       }
-      if (schema_id != 0) topic.type = schema->second;
+      // Schema id 0 is MCAP's "no schema": say so where the type would be shown (it was empty).
+      topic.type = schema_id != 0 ? schema->second : "<no schema: schema_id 0>";
       if (channels_.count(id) == 0) order_.push_back(id);
       channels_[id] = std::make_unique<StorageTopic>(std::move(topic));
     } else if (opcode == kOpMessage) {

@@ -109,6 +109,13 @@ class SqliteBag {
     std::vector<std::pair<sqlite3_int64, sqlite3_int64>> order;  // (timestamp, id)
     Statement stamps = Prepare("SELECT timestamp, id FROM messages");
     while (Step(stamps)) {
+      // SQLite converts any value to an integer when asked; text read as 0 (a stamp at 1970).
+      const int type = sqlite3_column_type(stamps.get(), 0);
+      if (type != SQLITE_INTEGER) {
+        throw std::invalid_argument(
+            path_ + ": message id " + std::to_string(sqlite3_column_int64(stamps.get(), 1)) +
+            ": messages.timestamp is " + TypeName(type) + ", not an integer (nanoseconds)");
+      }
       order.emplace_back(sqlite3_column_int64(stamps.get(), 0),
                          sqlite3_column_int64(stamps.get(), 1));
     }
@@ -118,6 +125,11 @@ class SqliteBag {
       sqlite3_reset(message.get());
       sqlite3_bind_int64(message.get(), 1, id);
       if (!Step(message)) Fail("message id " + std::to_string(id) + " vanished");
+      if (sqlite3_column_type(message.get(), 0) != SQLITE_INTEGER) {
+        throw std::invalid_argument(
+            path_ + ": message id " + std::to_string(id) + ": messages.topic_id is " +
+            TypeName(sqlite3_column_type(message.get(), 0)) + ", not an integer");
+      }
       const sqlite3_int64 topic_id = sqlite3_column_int64(message.get(), 0);
       const auto topic = topics.find(topic_id);
       if (topic == topics.end()) {
@@ -266,6 +278,21 @@ class SqliteBag {
     if (status == SQLITE_ROW) return true;
     if (status == SQLITE_DONE) return false;
     Fail("cannot read the database");
+  }
+
+  static const char* TypeName(int type) {
+    switch (type) {
+      case SQLITE_INTEGER:
+        return "an integer";
+      case SQLITE_FLOAT:
+        return "a real number";
+      case SQLITE_TEXT:
+        return "text";
+      case SQLITE_BLOB:
+        return "a blob";
+      default:
+        return "null";
+    }
   }
 
   static std::string Text(const Statement& statement, int column) {

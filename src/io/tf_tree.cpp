@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "common/shown_text.hpp"
+
 namespace keyplace {
 
 std::string NormalizeFrame(const std::string& frame) {
@@ -79,9 +81,16 @@ std::vector<double> TfTree::ChainStamps(const std::string& ancestor,
 
 std::string TfTree::Describe() const {
   if (edge_of_child_.empty()) return "no transforms";
+  // Bounded: frame ids come from the bag, and a message must not grow with them.
+  constexpr std::size_t kShown = 20;
   std::string text;
+  std::size_t shown = 0;
   for (const auto& [child, edge] : edge_of_child_) {
-    text += (text.empty() ? "" : ", ") + edge.parent + " -> " + child +
+    if (shown++ == kShown) {
+      text += ", and " + std::to_string(edge_of_child_.size() - kShown) + " more";
+      break;
+    }
+    text += (text.empty() ? "" : ", ") + ShownText(edge.parent) + " -> " + ShownText(child) +
             (edge.samples.empty() ? " (static)" : "");
   }
   return text;

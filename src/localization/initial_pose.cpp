@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/config_fields.hpp"
+#include "common/shown_text.hpp"
 #include "io/atomic_file.hpp"
 
 namespace keyplace {
@@ -18,22 +19,26 @@ bool EndsWith(const std::string& text, const std::string& suffix) {
          text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+}  // namespace
+
 // A frame id as ROS names them (letters, digits, '_', '/', '.', '-'): written as is in YAML and
 // JSON, so anything else is refused rather than escaped.
-void CheckFrameId(const std::string& frame_id) {
+void CheckInitialPoseFrameId(const std::string& frame_id) {
   const bool valid = !frame_id.empty() && std::all_of(frame_id.begin(), frame_id.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '/' || c == '.' ||
            c == '-';
   });
   if (!valid) {
-    throw std::invalid_argument("initial pose: frame id '" + frame_id +
+    throw std::invalid_argument("initial pose: frame id '" + ShownText(frame_id) +
                                 "' is not a ROS frame name (letters, digits, _ / . -)");
   }
 }
 
+namespace {
+
 // The message's fields in the flow style both YAML and (with quoted keys) JSON take.
 std::string MessageText(const InitialPose& pose, bool json) {
-  CheckFrameId(pose.frame_id);
+  CheckInitialPoseFrameId(pose.frame_id);
   const auto key = [json](const char* name) {
     return json ? "\"" + std::string(name) + "\": " : std::string(name) + ": ";
   };
@@ -72,6 +77,7 @@ InitialPose InitialPoseOf(const RelocalizationUpdate& update, const std::string&
     throw std::invalid_argument("an initial pose needs a fix; the localizer is " +
                                 ToString(update.status));
   }
+  CheckInitialPoseFrameId(frame_id);
   InitialPose pose;
   pose.frame_id = frame_id;
   pose.T_map_robot = update.T_world_robot;

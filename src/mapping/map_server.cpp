@@ -15,6 +15,8 @@
 
 #include "common/config_fields.hpp"
 #include "io/atomic_file.hpp"
+#include "io/bounded_read.hpp"
+#include "io/yaml_document.hpp"
 
 namespace keyplace {
 namespace {
@@ -83,19 +85,38 @@ int HeaderNumber(const std::string& bytes, std::size_t& at, const std::string& p
   return std::stoi(token);
 }
 
+// The header is read from the first kMaxPgmHeaderBytes, then exactly the pixels it declares (at
+// most kMaxMapServerPixels): /dev/zero or a huge file is never read whole (it was, 2 GB, then
+// std::bad_alloc).
 void ReadImage(MapServerMap& map) {
   const std::string& path = map.image_path;
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the map image");
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string bytes(kMaxPgmHeaderBytes, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
   std::size_t at = 0;
   if (HeaderToken(bytes, at) != "P5") Fail(path, "not a binary PGM image (magic P5)");
   map.width = HeaderNumber(bytes, at, path, "width");
   map.height = HeaderNumber(bytes, at, path, "height");
   if (HeaderNumber(bytes, at, path, "maxval") != 255) Fail(path, "maxval must be 255 (8 bits)");
   ++at;  // the single whitespace after maxval
+  if (at >= bytes.size() && bytes.size() == kMaxPgmHeaderBytes) {
+    Fail(path, "a PGM header longer than " + std::to_string(kMaxPgmHeaderBytes) + " bytes");
+  }
   const std::size_t count =
       static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height);
+  if (count > kMaxMapServerPixels) {
+    Fail(path, std::to_string(map.width) + " x " + std::to_string(map.height) +
+                   " pixels, more than the " + std::to_string(kMaxMapServerPixels) +
+                   " (16384 x 16384) keyplace reads");
+  }
+  if (bytes.size() < at + count) {
+    const std::size_t present = bytes.size();
+    bytes.resize(at + count);
+    in.read(bytes.data() + present, static_cast<std::streamsize>(at + count - present));
+    bytes.resize(present + static_cast<std::size_t>(in.gcount()));
+  }
   if (bytes.size() < at + count) {
     Fail(path, std::to_string(map.width) + " x " + std::to_string(map.height) +
                    " pixels declared, " +
@@ -161,14 +182,8 @@ double MapServerMap::Occupancy(int column, int image_row) const {
 }
 
 MapServerMap ReadMapServerMap(const std::string& yaml_path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(yaml_path + ": cannot open the map YAML");
-  } catch (const YAML::Exception& error) {
-    Fail(yaml_path, "line " + std::to_string(error.mark.line + 1) + ": " + error.msg);
-  }
+  const YAML::Node root =
+      LoadYamlDocument(ReadWholeFile(yaml_path, kMaxMapServerYamlBytes, "map YAML"), yaml_path);
   if (!root.IsMap()) Fail(yaml_path, "not a YAML mapping of map_server keys");
   MapServerMap map;
   const auto image = Required<std::string>(root, "image", yaml_path);

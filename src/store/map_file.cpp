@@ -19,6 +19,9 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "io/bounded_read.hpp"
+#include "keyplace/config/config.hpp"
+#include "keyplace/io/carmen_log.hpp"
 #include "store/map_checksum.hpp"
 #include "store/map_file_checks.hpp"
 #include "store/map_schema.hpp"
@@ -30,6 +33,10 @@ namespace {
 constexpr const char* kFormatName = "keyplace-map";
 // Version 1 has the same tables and no content checksum; it is still read.
 constexpr int kOldestReadableVersion = 1;
+
+// Positions of poses and keypoints: the log readers' bound (CarmenReadOptions::max_coordinate_m,
+// also the bags' reader), so that a map holds no place its inputs could not.
+const double kMaxCoordinateM = CarmenReadOptions{}.max_coordinate_m;
 
 // deflate expands at most 1032:1 (a 258-byte match per ~2-bit code); zlib adds 6 bytes.
 constexpr std::uint64_t kMaxDeflateRatio = 1032;
@@ -93,6 +100,23 @@ class Row {
     if (value < min || value > max) {
       Fail(column, std::to_string(value) + " outside [" + std::to_string(min) + ", " +
                        std::to_string(max) + "]");
+    }
+    return value;
+  }
+  // A position within the bound the log readers put on coordinates (CarmenReadOptions): a map
+  // is made from them, so anything farther was written by something else.
+  double Coordinate(int index, const char* column) const {
+    const double value = Real(index, column);
+    if (!(std::abs(value) <= kMaxCoordinateM)) {
+      Fail(column, std::to_string(value) + " m lies beyond +-" + std::to_string(kMaxCoordinateM) +
+                       " m (the bound of the log readers)");
+    }
+    return value;
+  }
+  double Angle(int index, const char* column) const {
+    const double value = Real(index, column);
+    if (!(std::abs(value) <= 2.0 * M_PI)) {
+      Fail(column, std::to_string(value) + " rad is not an angle in [-2 pi, 2 pi]");
     }
     return value;
   }
@@ -200,6 +224,7 @@ class MapReader {
     CheckChecksum(db, version);
     ReadConfig(db, map);
     Passed("mapping configuration (table config) valid");
+    CheckRecordedConfiguration(map);
     ReadRows(db, map);
     return map;
   }
@@ -274,6 +299,24 @@ class MapReader {
     } catch (const std::invalid_argument& error) {
       Fail(std::string("table config: ") + error.what());
     }
+  }
+
+  // The whole configuration recorded as YAML (meta configuration) is checked as a --config file
+  // would be, before any command uses or copies it (merge writes it into its result).
+  void CheckRecordedConfiguration(const GlobalMap& map) {
+    if (map.configuration.empty()) return;
+    const std::string source = "recorded configuration (table meta)";
+    if (map.configuration.size() > kMaxConfigFileBytes) {
+      Fail(source + ": " + std::to_string(map.configuration.size()) + " bytes, more than the " +
+           std::to_string(kMaxConfigFileBytes) + " of a configuration file");
+    }
+    try {
+      Config whole;
+      ApplyConfigYaml(map.configuration, source, whole);
+    } catch (const std::invalid_argument& error) {
+      Fail(error.what());
+    }
+    Passed("recorded configuration (table meta) valid");
   }
 
   // Rows of `table` checked against what a file of this size can hold, before any allocation
@@ -358,7 +401,8 @@ class MapReader {
       Submap& submap = SubmapOf(row, map, row.Integer(1, "submap_id", 0, kIntMax));
       CheckSeq(row, row.Integer(2, "seq", 0, kIntMax), submap.poses.size());
       submap.scan_indices.push_back(row.Int(3, "scan_index"));
-      submap.poses.emplace_back(row.Real(4, "x"), row.Real(5, "y"), row.Real(6, "theta"));
+      submap.poses.emplace_back(row.Coordinate(4, "x"), row.Coordinate(5, "y"),
+                                row.Angle(6, "theta"));
     }
   }
 
@@ -371,9 +415,10 @@ class MapReader {
       Submap& submap = SubmapOf(row, map, row.Integer(1, "submap_id", 0, kIntMax));
       CheckSeq(row, row.Integer(2, "seq", 0, kIntMax), submap.keypoints.size());
       StableKeypoint keypoint;
-      keypoint.position_m = {row.Real(3, "x"), row.Real(4, "y")};
-      keypoint.orientation_rad = row.Real(5, "orientation");
+      keypoint.position_m = {row.Coordinate(3, "x"), row.Coordinate(4, "y")};
+      keypoint.orientation_rad = row.Angle(5, "orientation");
       keypoint.scale_m = row.Real(6, "scale");
+      if (!(keypoint.scale_m > 0.0)) row.Fail("scale", "not positive");
       keypoint.scale_level = row.Int(7, "level");
       keypoint.scan_index = row.Int(8, "scan_index");
       const double stability = row.Real(9, "stability");
@@ -389,16 +434,28 @@ class MapReader {
                                    std::to_string(keypoint.descriptor.size()) + " float32)");
       }
       std::memcpy(keypoint.descriptor.data(), descriptor, descriptor_bytes);
-      for (std::size_t bin = 0; bin < keypoint.descriptor.size(); ++bin) {
-        if (!std::isfinite(keypoint.descriptor[bin])) {
-          row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
-        }
-        // Histograms: the descriptor index's bound (H <= 2 chi2) holds for bins >= 0 only.
-        if (keypoint.descriptor[bin] < 0.0f) {
-          row.Fail("descriptor", "bin " + std::to_string(bin) + " is negative");
-        }
-      }
+      CheckHistogram(row, keypoint.descriptor);
       submap.keypoints.push_back(keypoint);
+    }
+  }
+
+  // A descriptor is a histogram: finite bins >= 0 (the descriptor index's bound H <= 2 chi2 holds
+  // for those only) that sum to 1 (BetaGridDescriptor normalises them; all zeros is no histogram).
+  static void CheckHistogram(const Row& row, const BetaGridDescriptor& descriptor) {
+    double sum = 0.0;
+    for (std::size_t bin = 0; bin < descriptor.size(); ++bin) {
+      if (!std::isfinite(descriptor[bin])) {
+        row.Fail("descriptor", "bin " + std::to_string(bin) + " is not a finite number");
+      }
+      // Histograms: the descriptor index's bound (H <= 2 chi2) holds for bins >= 0 only.
+      if (descriptor[bin] < 0.0f) {
+        row.Fail("descriptor", "bin " + std::to_string(bin) + " is negative");
+      }
+      sum += descriptor[bin];
+    }
+    // float rounding of 100 bins that sum to 1 stays far below 1e-3.
+    if (!(std::abs(sum - 1.0) <= 1e-3)) {
+      row.Fail("descriptor", "bins sum to " + std::to_string(sum) + ", not 1 (not a histogram)");
     }
   }
 

@@ -117,6 +117,37 @@ TEST(Config, BadFilesNameFileLineAndKey) {
   EXPECT_NE(malformed.find("malformed YAML"), std::string::npos) << malformed;
 }
 
+// Issue 31: what yaml-cpp alone let through or reported badly.
+TEST(Config, DuplicateKeysSecondDocumentsAndDeepNestingAreRefused) {
+  // yaml-cpp resolved a key given twice to one of its values (the last was applied).
+  EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs: 4\n  min_pairs: 5\n"),
+            "my.yaml:3: the key 'min_pairs' is given twice in one mapping (YAML allows one)");
+  EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs: 4\nplace:\n  min_gamma: 0.5\n"),
+            "my.yaml:3: the key 'place' is given twice in one mapping (YAML allows one)");
+  // A second document was ignored.
+  EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs: 4\n---\nplace:\n  min_pairs: 5\n"),
+            "my.yaml:4: a second YAML document (after '---'); the file must hold one");
+  // yaml-cpp's own message for nesting beyond its limit is "bad file".
+  const std::string deep = ErrorOfYaml(std::string(5000, '[') + std::string(5000, ']'));
+  EXPECT_EQ(deep.rfind("my.yaml:1: YAML nested too deeply (yaml-cpp stops at ", 0), 0u) << deep;
+  // A key of control bytes is shown escaped and bounded.
+  const std::string shown = ErrorOfYaml("\"a\\0b" + std::string(500, 'c') + "\": 1\n");
+  EXPECT_NE(shown.find("'a\\0bccc"), std::string::npos) << shown;
+  EXPECT_LT(shown.size(), 300u) << shown;
+}
+
+TEST(Config, AFileIsReadUpToItsLimitNamingFileAndLimit) {
+  Config config;
+  try {
+    ApplyConfigFile("/dev/zero", config);  // formerly 4.2 GB read, then "out of memory"
+    FAIL() << "/dev/zero was accepted";
+  } catch (const std::runtime_error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "/dev/zero: larger than 1 MiB, the limit of a configuration file (not read "
+              "further; is it the right file?)");
+  }
+}
+
 TEST(Config, AssignmentsAndFilesReportTheirErrors) {
   Config config;
   ApplyConfigAssignment("slam.graph.loop_reject_sigmas=4", config);

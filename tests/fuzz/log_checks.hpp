@@ -14,8 +14,9 @@ inline bool Finite(const Pose2& pose) {
   return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.theta);
 }
 
-// Beams within the cap with one angle and one validity flag each, finite angles and poses, valid
-// beams with usable ranges.
+// Beams within the cap with one angle and one validity flag each, finite angles within physical
+// limits (a start within +-2 pi and at most one turn of beams: issue 31's angle_increment 1e30),
+// finite poses, valid beams with usable ranges.
 inline void CheckLog(const CarmenLog& log) {
   for (const LogScan& scan : log.scans) {
     const std::string where = "scan of line " + std::to_string(scan.line);
@@ -25,6 +26,9 @@ inline void CheckLog(const CarmenLog& log) {
     }
     for (std::size_t i = 0; i < scan.size(); ++i) {
       if (!std::isfinite(scan.angles_rad[i])) Finding(where + ": a beam angle is not finite");
+      if (!(std::abs(scan.angles_rad[i]) <= 4.0 * M_PI + 1e-6)) {
+        Finding(where + ": a beam angle beyond +-4 pi (a start within +-2 pi, one turn of beams)");
+      }
       const double range = scan.ranges_m[i];
       if (scan.valid[i] != 0 &&
           !(std::isfinite(range) && range >= 0.0 && range < scan.max_range_m)) {

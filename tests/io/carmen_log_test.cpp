@@ -164,9 +164,52 @@ TEST(CarmenLog, NonNumericFieldIsNamed) {
   ExpectError<std::invalid_argument>(count, {count + ":1", "beam count"});
 }
 
+// Issue 31: a file whose magic is a bag's or a database's but for a byte or two is that file
+// damaged; it used to read as a log without scans ("is this a CARMEN log?").
+TEST(CarmenLog, ABagOrDatabaseWithADamagedMagicIsNamedAsSuch) {
+  const struct {
+    std::string head;
+    const char* kind;
+  } cases[] = {
+      {"#ROSBAG V2.1\n", "a damaged ROS 1 bag"},
+      {"#ROSBAX V2.0\n", "a damaged ROS 1 bag"},
+      {std::string("\x89MCAP1\r\n", 8), "a damaged ROS 2 MCAP file"},
+      {std::string("\x89MCAP0\n\n", 8), "a damaged ROS 2 MCAP file"},
+      {std::string("SQLite format 4\0", 16), "a damaged SQLite database"},
+  };
+  for (const auto& damaged : cases) {
+    SCOPED_TRACE(damaged.kind);
+    const std::string path =
+        WriteText("damaged.bin", damaged.head + std::string(64, '\x01') + "FLASER 1 1\n");
+    ExpectError<std::invalid_argument>(path, {path + ": " + damaged.kind, "not read"});
+  }
+  // Text that merely begins like a comment is still a log.
+  const std::string log = WriteText(
+      "comment.log", "#ROSBAG-like comment, but a log\n" + Flaser(4, "1", "0 0 0 0 0 0 1 h 1"));
+  EXPECT_EQ(ReadCarmenLog(log).scans.size(), 1u);
+}
+
+// Issue 31: a NUL byte cut the quoted text where C strings end; a long field was quoted whole.
+TEST(CarmenLog, QuotedFieldsAreEscapedAndBounded) {
+  static constexpr char kNulLine[] = "FLASER 2 1 2 0 ze\0ro 0 0 0 0 1 h 1\n";
+  const std::string nul = WriteText("nul.log", std::string(kNulLine, sizeof(kNulLine) - 1));
+  ExpectError<std::invalid_argument>(nul, {nul + ":1", "'ze\\0ro'"});
+  const std::string long_field =
+      WriteText("long.log", "FLASER 2 1 2 0 " + std::string(100000, 'y') + " 0 0 0 0 1 h 1\n");
+  try {
+    ReadCarmenLog(long_field);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_LT(std::string(error.what()).size(), 400u);
+    EXPECT_NE(std::string(error.what()).find("... (100000 bytes)"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(CarmenLog, NonFiniteOrAbsurdFieldOfViewIsAnErrorNamingTheLine) {
   // Formerly an infinite field of view was taken and made every beam angle NaN.
-  for (const std::string value : {"inf", "1e300", "720"}) {
+  // NaN was ignored (the default applied) while infinity was refused (issue 31).
+  for (const std::string value : {"inf", "1e300", "720", "nan", "-nan", "NaN"}) {
     const std::string path = WriteText("fov_" + value + ".log",
                                        "# c\nPARAM laser_front_laser_fov " + value + " nohost 0\n" +
                                            Flaser(10, "1.0", "0 0 0 0 0 0 1 h 1"));

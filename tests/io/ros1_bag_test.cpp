@@ -285,6 +285,21 @@ TEST(Ros1Bag, AnIndexPositionWhereNoRecordStartsIsReadWithoutTheIndex) {
   ExpectContains(log.warnings.front(), path + ": the bag's index is missing or damaged");
 }
 
+// Issue 31: a bag header counting 0 chunks (chunk_count=0) made the index hold no chunk, and the
+// bag read as "the bag has no topics". The header disagrees with the file: its chunks are walked,
+// with the warning of a damaged index.
+TEST(Ros1Bag, AChunkCountOtherThanTheFilesIsADamagedIndex) {
+  std::string bytes = ReadBytes(Fr079Bag());
+  const std::size_t chunk_count = bytes.find("chunk_count=") + 12;
+  ASSERT_EQ(U32At(bytes, chunk_count), 20u);
+  SetU32At(bytes, chunk_count, 0);
+  const std::string path = WriteBytes("chunk-count-0.bag", bytes);
+  const CarmenLog log = ReadCarmenLog(path, Reading(Fr079AsLog()));
+  EXPECT_EQ(log.scans.size(), 4934u);
+  ASSERT_FALSE(log.warnings.empty());
+  ExpectContains(log.warnings.front(), path + ": the bag's index is missing or damaged");
+}
+
 // The fuzzer's input (tests/fuzz/regressions/ros1_bag/): rosbag's written bag of a /tf_static, a
 // /tf and a /scan message with an index entry pointing near the end of the chunk; rosbag read a
 // header beyond the chunk's buffer (AddressSanitizer: heap-buffer-overflow in ros::Header::parse).

@@ -7,11 +7,15 @@
 #include "keyplace/io/ros2_bag.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -484,6 +488,124 @@ TEST(Ros2Cdr, BigAndLittleEndianMessagesDecodeAlike) {
   for (std::size_t size = 0; size < little.size(); ++size) {
     EXPECT_THROW(decode(little.substr(0, size)), CdrError) << size;
   }
+}
+
+// Issue 31: one storage file listed 2000 times made a 450 KB bag read as 300 000 scans.
+TEST(Ros2Bag, AStorageFileListedTwiceIsRefused) {
+  const std::string bag = CopyFixture("mcap-none");
+  const std::string metadata = bag + "/metadata.yaml";
+  std::string text = ReadBytes(metadata);
+  Replace(text, "    - mcap-none_0.mcap\n  files:",
+          "    - mcap-none_0.mcap\n    - ./mcap-none_0.mcap\n  files:");
+  WriteBytes(metadata, text);
+  ExpectContains(ErrorOf(bag), metadata +
+                                   ": lists the storage file ./mcap-none_0.mcap more than "
+                                   "once (relative_file_paths)");
+}
+
+// Issue 31: a metadata.yaml was read whole whatever its size (/dev/zero: until memory ran out);
+// duplicate keys resolved to one of their values, a second document was ignored.
+TEST(Ros2Bag, MetadataIsReadUpToItsLimitAndAsOneDocumentWithoutDuplicateKeys) {
+  const std::string bag = CopyFixture("mcap-none");
+  const std::string metadata = bag + "/metadata.yaml";
+  const std::string original = ReadBytes(metadata);
+  fs::remove(metadata);
+  fs::create_symlink("/dev/zero", metadata);
+  try {  // std::runtime_error, as for a metadata file that cannot be opened
+    ReadRos2Bag(metadata);
+    FAIL() << "/dev/zero read as metadata";
+  } catch (const std::runtime_error& error) {
+    ExpectContains(error.what(),
+                   metadata + ": larger than 16 MiB, the limit of a rosbag2 metadata file");
+  }
+  fs::remove(metadata);
+  std::string text = original;
+  Replace(text, "  storage_identifier: mcap\n",
+          "  storage_identifier: mcap\n  storage_identifier: sqlite3\n");
+  WriteBytes(metadata, text);
+  ExpectContains(ErrorOf(bag), metadata + ":4: the key 'storage_identifier' is given twice");
+  WriteBytes(metadata, original + "---\n" + original);
+  ExpectContains(ErrorOf(bag), "a second YAML document");
+}
+
+// Sets the float32 field of every /scan message of an sqlite3 bag at `field` (0 angle_min,
+// 1 angle_max, 2 angle_increment), after the CDR header, stamp and frame id.
+void SetScanAngleField(const std::string& db3, int field, float value) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(db3.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* rows = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT id, data FROM messages WHERE topic_id = (SELECT id FROM "
+                               "topics WHERE name = '/scan')",
+                               -1, &rows, nullptr),
+            SQLITE_OK);
+  std::vector<std::pair<sqlite3_int64, std::string>> changed;
+  ASSERT_EQ(sqlite3_exec(db, "BEGIN", nullptr, nullptr, nullptr), SQLITE_OK);
+  while (sqlite3_step(rows) == SQLITE_ROW) {
+    std::string data(static_cast<const char*>(sqlite3_column_blob(rows, 1)),
+                     static_cast<std::size_t>(sqlite3_column_bytes(rows, 1)));
+    std::uint32_t frame_bytes = 0;  // little-endian CDR (the fixtures' encoding)
+    std::memcpy(&frame_bytes, data.data() + 12, 4);
+    // The payload starts after the 4-byte encapsulation header; floats align to 4 within it.
+    std::size_t at = 16 + frame_bytes;
+    at = 4 + ((at - 4 + 3) / 4) * 4 + 4 * static_cast<std::size_t>(field);
+    std::memcpy(data.data() + at, &value, 4);
+    changed.emplace_back(sqlite3_column_int64(rows, 0), std::move(data));
+  }
+  sqlite3_finalize(rows);
+  ASSERT_FALSE(changed.empty());
+  for (const auto& [id, data] : changed) {
+    sqlite3_stmt* update = nullptr;
+    ASSERT_EQ(
+        sqlite3_prepare_v2(db, "UPDATE messages SET data = ? WHERE id = ?", -1, &update, nullptr),
+        SQLITE_OK);
+    sqlite3_bind_blob(update, 1, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
+    sqlite3_bind_int64(update, 2, id);
+    ASSERT_EQ(sqlite3_step(update), SQLITE_DONE);
+    sqlite3_finalize(update);
+  }
+  ASSERT_EQ(sqlite3_exec(db, "COMMIT", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+}
+
+// Issue 31: angle_increment 0 or 1e30 and angle_min 1e30 ("field of view 2.06e34 deg") mapped with
+// exit 0; the bounds are those of the CARMEN reader's ROBOTLASER1 angles.
+TEST(Ros2Bag, ScanAnglesBeyondOneTurnAreRefused) {
+  const struct {
+    int field;
+    float value;
+    const char* expected;
+  } cases[] = {
+      {2, 0.0F, ": topic /scan: scan 1: angle_increment = 0 rad over 360 beams"},
+      {2, 1e30F, ": topic /scan: scan 1: angle_increment = 1e+30 rad over 360 beams"},
+      {2, 0.0175F * 1.02F, "does not spread them over at most one turn"},
+      {0, 1e30F, ": topic /scan: scan 1: angle_min = 1e+30 rad"},
+      {0, -7.0F, "is not an angle in [-2 pi, 2 pi]"},
+  };
+  for (const auto& bad : cases) {
+    SCOPED_TRACE(bad.expected);
+    const std::string bag = CopyFixture("sqlite3");
+    SetScanAngleField(bag + "/sqlite3_0.db3", bad.field, bad.value);
+    ExpectContains(ErrorOf(bag), bad.expected);
+  }
+  // A scan turning the other way (negative increment) within one turn still reads.
+  const std::string bag = CopyFixture("sqlite3");
+  SetScanAngleField(bag + "/sqlite3_0.db3", 2, -0.0174F);
+  EXPECT_EQ(ReadRos2Bag(bag).scans.size(), 150u);
+}
+
+// Issue 31: text in messages.timestamp read as 0 (SQLite converts what it is asked to).
+TEST(Ros2Bag, ATimestampThatIsNoIntegerIsRefused) {
+  const std::string bag = CopyFixture("sqlite3");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((bag + "/sqlite3_0.db3").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "UPDATE messages SET timestamp = 'noon' WHERE id = (SELECT min(id) FROM "
+                         "messages)",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  ExpectContains(ErrorOf(bag), ": messages.timestamp is text, not an integer (nanoseconds)");
 }
 
 }  // namespace

@@ -178,6 +178,22 @@ TEST(InitialPose, AFrameIdThatIsNoRosNameIsRefused) {
   EXPECT_THROW(InitialPoseJson(pose), std::invalid_argument);
   pose.frame_id = "robot_1/map";
   EXPECT_NO_THROW(InitialPoseYaml(pose));
+  // Issue 31: refused when made from a fix too, not only when written; the id shown escaped.
+  const RelocalizationUpdate fixed = filter.Update(std::nullopt, Odometry(8));
+  EXPECT_NO_THROW(InitialPoseOf(fixed, "map"));
+  try {
+    InitialPoseOf(fixed, "bad name!");
+    FAIL() << "'bad name!' was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("frame id 'bad name!'"), std::string::npos);
+  }
+  try {
+    CheckInitialPoseFrameId(std::string("a\0b", 3));
+    FAIL() << "a NUL byte was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "initial pose: frame id 'a\\0b' is not a ROS frame name (letters, digits, _ / . -)");
+  }
 }
 
 TEST(InitialPose, NoFixNoInitialPose) {

@@ -285,6 +285,18 @@ TEST(MapServer, BadFilesAreNamedErrors) {
                      "image: short.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
                      "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"),
                "4 x 4 pixels declared, 5 bytes");
+  // Issue 31: files read whole were not bounded (`image: /dev/zero` read 2 GB, then bad_alloc).
+  const std::string keys =
+      "resolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\n"
+      "free_thresh: 0.196\n";
+  expect_error(write("zero.yaml", "image: /dev/zero\n" + keys),
+               "/dev/zero: not a binary PGM image (magic P5)");
+  write("huge.pgm", "P5\n20000 20000\n255\n");
+  expect_error(write("huge.yaml", "image: huge.pgm\n" + keys),
+               "huge.pgm: 20000 x 20000 pixels, more than the 268435456 (16384 x 16384)");
+  expect_error("/dev/zero", "/dev/zero: larger than 1 MiB, the limit of a map YAML");
+  expect_error(write("twice.yaml", "image: ok.pgm\nimage: short.pgm\n" + keys),
+               "twice.yaml:2: the key 'image' is given twice");
   const MapServerMap ok =
       ReadMapServerMap(write("ok.yaml",
                              "image: ok.pgm\nresolution: 0.05\norigin: [1.5, -2, 0]\nnegate: 0\n"

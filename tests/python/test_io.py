@@ -101,6 +101,10 @@ class ErrorsTest(unittest.TestCase):
             keyplace.Config(overrides={"place.min_pairs": "many"})
         with self.assertRaisesRegex(ValueError, "preset"):
             keyplace.Config("no-such-preset")
+        # Issue 31: a bare "MemoryError std::bad_alloc" after reading gigabytes before.
+        with self.assertRaisesRegex(RuntimeError, "/dev/zero: larger than 1 MiB, the limit of a "
+                                                  "configuration file"):
+            keyplace.Config(file="/dev/zero")
 
     def test_mismatched_beams_raise(self):
         with self.assertRaisesRegex(ValueError, "3 ranges but 2 angles"):

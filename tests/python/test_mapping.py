@@ -78,6 +78,28 @@ class MapTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "mapping.no_such_key"):
             keyplace.build_map(BUNDLED_LOG, overrides={"mapping.no_such_key": 1})
 
+    def test_bad_scan_ranges_raise_naming_the_argument(self):
+        # Issue 31: pybind11's "Unable to cast" before.
+        for scans in ("9:3", (9, 3), (-1, 5), (1, 2, 3), (1.5, 3), 7):
+            with self.assertRaisesRegex(ValueError, r"scans=.*: expected \(first, end\), two "
+                                                    r"integers with 0 <= first <= end"):
+                keyplace.build_map(BUNDLED_LOG, scans=scans)
+
+    def test_save_refuses_the_log_the_map_was_made_from(self):
+        # Issue 31: the Python writers protect their inputs as the CLI does; the map knows its
+        # log by content (source_hash), so a copy or a link of it is refused too.
+        copy = os.path.join(self.work.name, "copy.log.gz")
+        with open(BUNDLED_LOG, "rb") as source, open(copy, "wb") as target:
+            before = source.read()
+            target.write(before)
+        link = os.path.join(self.work.name, "link.log.gz")
+        os.symlink(copy, link)
+        for path in (copy, link):
+            with self.assertRaisesRegex(ValueError, "is the log the map was made from"):
+                self.map.save(path)
+        with open(copy, "rb") as stream:
+            self.assertEqual(stream.read(), before)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -116,6 +116,23 @@ class GridTest(unittest.TestCase):
         with self.assertRaisesRegex(RuntimeError, "no-such-dir"):
             self.grid.write_map_server(os.path.join(self.work.name, "no-such-dir", "g.yaml"))
 
+    def test_write_map_server_refuses_the_log_it_was_built_from(self):
+        # Issue 31: the Python writers protect their inputs as the CLI does, under any name.
+        with open(self.log_path, "rb") as stream:
+            before = stream.read()
+        yaml_alias = os.path.join(self.work.name, "log-alias.yaml")
+        os.symlink(self.log_path, yaml_alias)
+        for target in (yaml_alias,):
+            with self.assertRaisesRegex(ValueError, "would destroy the input"):
+                self.grid.write_map_server(target)
+        image_alias = os.path.join(self.work.name, "image-alias.pgm")
+        os.link(self.log_path, image_alias)
+        with self.assertRaisesRegex(ValueError, "image-alias.pgm: is the input"):
+            self.grid.write_map_server(os.path.join(self.work.name, "image-alias.yaml"))
+        with open(self.log_path, "rb") as stream:
+            self.assertEqual(stream.read(), before)
+        self.assertFalse(os.path.exists(os.path.join(self.work.name, "image-alias.yaml")))
+
 
 class InitialPoseTest(unittest.TestCase):
     def test_message_fields(self):
@@ -142,6 +159,11 @@ class InitialPoseTest(unittest.TestCase):
                     self.assertEqual(stream.read(), text)
         with self.assertRaisesRegex(ValueError, "not a ROS frame name"):
             keyplace.InitialPose([0, 0, 0], frame_id="my map").to_yaml()
+        # Issue 31: refused when made, as the docs say, not only when written.
+        with self.assertRaisesRegex(ValueError, "frame id 'bad name!' is not a ROS frame name"):
+            keyplace.InitialPose([0, 0, 0], frame_id="bad name!")
+        with self.assertRaisesRegex(ValueError, r"'a\\0b' is not a ROS frame name"):
+            keyplace.InitialPose([0, 0, 0], frame_id="a\0b")
         with self.assertRaisesRegex(ValueError, "pose"):
             keyplace.InitialPose([0, 0])
         with self.assertRaisesRegex(ValueError, "covariance"):

@@ -63,7 +63,10 @@ GlobalMap RandomMap(int submaps, unsigned seed) {
       keypoint.scan_index = 10 * s + k % 5;
       keypoint.stability = static_cast<float>(uniform(rng));
       keypoint.occurrences = k;
-      for (auto& bin : keypoint.descriptor) bin = static_cast<float>(std::abs(uniform(rng)));
+      // A histogram, as FLIRT's descriptors are (LoadMap checks that the bins sum to 1).
+      float sum = 0.0F;
+      for (auto& bin : keypoint.descriptor) sum += bin = static_cast<float>(std::abs(uniform(rng)));
+      for (auto& bin : keypoint.descriptor) bin /= sum;
       submap.keypoints.push_back(keypoint);
     }
     submap.occupancy.cell_size_m = 0.1;
@@ -511,6 +514,29 @@ TEST(MapFile, StoredConfigIsValidatedLikeAUsersNamingFileAndKey) {
   ExpectRejected(path, {"table config: ", "max_grid_cells"});
 }
 
+// The whole configuration a map records is checked at load, not only by info --check: localize
+// used it and merge copied it into its result (issue 31).
+TEST(MapFile, ARecordedConfigurationThatIsNoConfigurationIsRejected) {
+  const struct {
+    const char* yaml;
+    const char* expected;
+  } cases[] = {
+      {"place: &loop\n  again: *loop\n", "place.again: expected a value, found a mapping"},
+      {"place:\n  min_pairs: 4\n  min_pairs: 5\n", "the key 'min_pairs' is given twice"},
+      {"place:\n  min_pairs: 4\n---\nplace:\n  min_pairs: 5\n", "a second YAML document"},
+      {"mapping:\n  no_such: 1\n", "unknown configuration key 'mapping.no_such'"},
+  };
+  for (const auto& bad : cases) {
+    SCOPED_TRACE(bad.yaml);
+    const std::string path = SavedRandomMap("recorded.kpm");
+    ExecuteSql(path, std::string("INSERT OR REPLACE INTO meta(key, value) VALUES "
+                                 "('configuration', '") +
+                         bad.yaml + "')");
+    Reseal(path);
+    ExpectRejected(path, {": recorded configuration (table meta):", bad.expected});
+  }
+}
+
 TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
   // A NaN float32 (0x7fc00000, little endian) in the first bin of a 192-byte descriptor.
   const std::string kNanDescriptor = "UPDATE keypoints SET descriptor = x'0000c07f" +
@@ -519,6 +545,9 @@ TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
   const std::string kNegativeDescriptor = "UPDATE keypoints SET descriptor = x'00000000000080bf" +
                                           std::string(std::size_t{2} * 184, '0') +
                                           "' WHERE rowid = 6";
+  // 1.0f (0x3f800000) in bins 0 and 1: no histogram sums to 2.
+  const std::string kTwoDescriptor = "UPDATE keypoints SET descriptor = x'0000803f0000803f" +
+                                     std::string(std::size_t{2} * 184, '0') + "' WHERE rowid = 9";
   const struct {
     const char* sql;
     std::initializer_list<const char*> expected;
@@ -535,6 +564,24 @@ TEST(MapFile, BadValuesNameTheTableRowAndColumn) {
        {"table keypoints, row 8, column descriptor: bin 0 is not a finite number"}},
       {kNegativeDescriptor.c_str(),
        {"table keypoints, row 6, column descriptor: bin 1 is negative"}},
+      // Values a map cannot hold though they are finite (issue 31: they passed info --check,
+      // merged and localized once the checksum was recomputed).
+      {"UPDATE poses SET x = 1e300 WHERE rowid = 3",
+       {"table poses, row 3, column x: ", "m lies beyond +-10000000"}},
+      {"UPDATE poses SET y = -2e7 WHERE rowid = 4", {"table poses, row 4, column y: "}},
+      {"UPDATE poses SET theta = 7.0 WHERE rowid = 2",
+       {"table poses, row 2, column theta: ", "not an angle in [-2 pi, 2 pi]"}},
+      {"UPDATE keypoints SET x = -1e300 WHERE rowid = 4",
+       {"table keypoints, row 4, column x: ", "lies beyond"}},
+      {"UPDATE keypoints SET orientation = 1e308 WHERE rowid = 3",
+       {"table keypoints, row 3, column orientation: ", "not an angle"}},
+      {"UPDATE keypoints SET scale = 0.0 WHERE rowid = 5",
+       {"table keypoints, row 5, column scale: not positive"}},
+      {"UPDATE keypoints SET scale = -0.4 WHERE rowid = 6",
+       {"table keypoints, row 6, column scale: not positive"}},
+      {"UPDATE keypoints SET descriptor = zeroblob(192) WHERE rowid = 7",
+       {"table keypoints, row 7, column descriptor: bins sum to 0", "not a histogram"}},
+      {kTwoDescriptor.c_str(), {"table keypoints, row 9, column descriptor: bins sum to 2"}},
       {"UPDATE keypoints SET descriptor = hex(descriptor) WHERE rowid = 9",
        {"table keypoints, row 9, column descriptor: not a blob"}},
       {"UPDATE keypoints SET level = -1 WHERE rowid = 2",

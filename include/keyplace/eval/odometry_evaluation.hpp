@@ -36,6 +36,8 @@ struct OdometryRunOptions {
   // Register only the positions [begin, end) of the processing order (clamped to the log).
   std::size_t begin = 0;
   std::size_t end = static_cast<std::size_t>(-1);
+  // The log the scans come from, named in errors (the refusal of timestamps that cannot order).
+  std::string source;
 };
 
 /// Counts and times of a run, over the registered scans.

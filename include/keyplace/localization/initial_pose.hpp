@@ -21,6 +21,10 @@ struct InitialPose {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
+/// Throws std::invalid_argument unless `frame_id` is a ROS frame name (letters, digits, _ / . -):
+/// the message writes it as is in YAML and JSON. Every InitialPose made by keyplace is checked.
+void CheckInitialPoseFrameId(const std::string& frame_id);
+
 /// The fix of an update whose status is kFixed (std::invalid_argument otherwise): its pose and
 /// covariance. The one way to make the message from the localizer (the evaluation's FixEvent
 /// keeps what this gives at the fix).
