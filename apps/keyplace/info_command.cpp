@@ -44,6 +44,30 @@ double PathLength(const CarmenLog& log) {
   return length_m;
 }
 
+// How the FLASER lines' beams were spread (FlaserSpacing): "fov/n", "fov/(n-1)", "mixed", or null
+// without FLASER lines (ROBOTLASER1 lines and bags state their angles), with the scan counts.
+nlohmann::json FlaserSpacingJson(const CarmenLog& log) {
+  const std::size_t over_n = log.flaser_scans_fov_over_beams;
+  const std::size_t over_n_minus_one = log.flaser_scans_fov_over_beams_minus_one;
+  if (over_n + over_n_minus_one == 0) return nullptr;
+  std::string rule = "mixed";
+  if (over_n_minus_one == 0) rule = ToString(FlaserSpacing::kFovOverBeams);
+  if (over_n == 0) rule = ToString(FlaserSpacing::kFovOverBeamsMinusOne);
+  return {
+      {"rule", rule}, {"scans_fov_over_n", over_n}, {"scans_fov_over_n_minus_1", over_n_minus_one}};
+}
+
+std::string FlaserSpacingText(const nlohmann::json& spacing) {
+  const auto over_n = spacing["scans_fov_over_n"].get<std::size_t>();
+  const auto over_n_minus_one = spacing["scans_fov_over_n_minus_1"].get<std::size_t>();
+  const std::string even = "step fov/n from -fov/2 (even beam count, FLIRTLib's convention)";
+  const std::string odd =
+      "step fov/(n-1), first and last beam at -fov/2 and +fov/2 (odd beam count)";
+  if (over_n_minus_one == 0) return even;
+  if (over_n == 0) return odd;
+  return fmt::format("{} FLASER scans {}; {} {}", over_n, even, over_n_minus_one, odd);
+}
+
 nlohmann::json DescribeLog(const CarmenLog& log) {
   nlohmann::json json;
   json["file"] = log.path;
@@ -58,6 +82,7 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
   json["beams_per_scan_max"] = log.beams_per_scan_max;
   json["beams_total"] = log.beams_total;
   json["field_of_view_deg"] = log.first_scan_field_of_view_rad * 180.0 / M_PI;
+  json["flaser_beam_spacing"] = FlaserSpacingJson(log);
   json["invalid_beams"] = log.invalid_beams;
   json["no_return_beams"] = log.no_return_beams;
   double duration_s = 0.0;
@@ -99,6 +124,9 @@ void PrintLog(const nlohmann::json& json) {
     fmt::print("beams per scan  {}..{}\n", min_beams, max_beams);
   }
   fmt::print("field of view   {:.1f} deg\n", json["field_of_view_deg"].get<double>());
+  if (!json["flaser_beam_spacing"].is_null()) {
+    fmt::print("beam spacing    {}\n", FlaserSpacingText(json["flaser_beam_spacing"]));
+  }
   fmt::print("duration        {:.1f} s\n", json["duration_s"].get<double>());
   for (const auto& warning : json["timestamp_warnings"]) {
     fmt::print("timestamps      warning: logger timestamps: {}\n", warning.get<std::string>());

@@ -66,7 +66,7 @@ const ConfigFields<BagInputConfig>& BagInputConfigFields() {
               "ROS bags: laser on the robot x,y,theta; empty: from /tf_static or /tf")
         .Double("scan_fov_rad", &C::scan_fov_rad, "rad",
                 "ROS bags: > 0 spreads beams over this as CARMEN FLASER (start -fov/2, step "
-                "fov/n); 0: angles from the messages");
+                "fov/n, or fov/(n-1) for an odd n); 0: angles from the messages");
     return table;
   }();
   return fields;

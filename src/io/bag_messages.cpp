@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/shown_text.hpp"
+#include "keyplace/io/carmen_log.hpp"
 
 namespace keyplace {
 namespace {
@@ -118,10 +119,11 @@ void BagMessageSink::AddScan(const std::string& topic, const ScanFields& scan, d
   out.max_range_m = ShortestDecimal(scan.range_max);
   const double min_range_m = ShortestDecimal(scan.range_min);
   const std::size_t n = scan.ranges.size();
-  const double start_rad =
-      config_.scan_fov_rad > 0.0 ? -0.5 * config_.scan_fov_rad : ShortestDecimal(scan.angle_min);
+  // scan_fov_rad: spread as a FLASER line of n beams would be (FlaserSpacingOf).
+  const double start_rad = config_.scan_fov_rad > 0.0 ? FlaserBeamAngle(0, n, config_.scan_fov_rad)
+                                                      : ShortestDecimal(scan.angle_min);
   const double step_rad = config_.scan_fov_rad > 0.0
-                              ? (n > 0 ? config_.scan_fov_rad / static_cast<double>(n) : 0.0)
+                              ? (n > 0 ? config_.scan_fov_rad / FlaserSteps(n) : 0.0)
                               : ShortestDecimal(scan.angle_increment);
   if (!std::isfinite(start_rad) || !std::isfinite(step_rad)) {
     throw std::invalid_argument(where + "angle_min and angle_increment must be finite");

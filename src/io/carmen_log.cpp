@@ -526,7 +526,6 @@ double FlaserFieldOfView(const FieldParser& fields, const std::string& path,
     return "PARAM " + prefix + name + " = " + param.token + " (line " + std::to_string(param.line) +
            ")";
   };
-  const double n = static_cast<double>(beams);
   std::optional<double> fov_rad;
   if (params.fov) {
     if (params.fov->value <= 2.0 * M_PI) {
@@ -551,19 +550,20 @@ double FlaserFieldOfView(const FieldParser& fields, const std::string& path,
                 " disagree with this line's " + std::to_string(beams) +
                 " beams: " + DisagreementText(*fov_rad, as_degrees_rad, beams));
   }
-  // No field of view: the beams span n steps of the resolution (FLIRTLib's spreading).
-  const double implied_deg = n * resolution.value;
+  // No field of view: the beams span n or n - 1 steps of the resolution (FlaserSpacingOf).
+  const double steps = FlaserSteps(beams);
+  const double implied_deg = steps * resolution.value;
   if (beams >= 2 && implied_deg <= 2.0 * M_PI) {
     note(resolution, "resolution",
          "gives " + std::to_string(beams) + " beams a field of view of at most 2 pi");
-    return n * as_radians_rad;
+    return steps * as_radians_rad;
   }
   if (implied_deg > 360.0 + 0.5 * resolution.value) {
     fields.Fail(name_of(resolution, "resolution") + " gives this line's " + std::to_string(beams) +
-                " beams a field of view of " + Degrees(n * as_degrees_rad) +
+                " beams a field of view of " + Degrees(steps * as_degrees_rad) +
                 " degrees, more than a full turn");
   }
-  return n * as_degrees_rad;
+  return steps * as_degrees_rad;
 }
 
 // FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
@@ -578,17 +578,16 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   scan.line = line;
   scan.max_range_m = state.options.flaser_max_range_m;
   // FLASER carries no angular geometry: take the field of view from PARAM when the log gives it,
-  // else 180 degrees, and spread the beams as FLIRTLib does (start -fov/2, step fov/n).
+  // else 180 degrees, and spread the beams by the convention of their count (FlaserSpacingOf).
   const std::string prefix = front ? "laser_front_laser_" : "laser_rear_laser_";
   std::vector<std::pair<std::size_t, std::string>> notes;
   const double fov_rad = FlaserFieldOfView(
       fields, state.log.path, front ? state.front_laser : state.rear_laser, prefix, n, notes);
-  const double step_rad = n > 0 ? fov_rad / static_cast<double>(n) : 0.0;
   scan.ranges_m.resize(n);
   scan.angles_rad.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     scan.ranges_m[i] = fields.AnyNumber(2 + i, "range[" + std::to_string(i) + "]");
-    scan.angles_rad[i] = -0.5 * fov_rad + static_cast<double>(i) * step_rad;
+    scan.angles_rad[i] = FlaserBeamAngle(i, n, fov_rad);
   }
   const std::size_t p = 2 + n;
   const Pose2 laser(fields.Coordinate(p, "laser x"), fields.Coordinate(p + 1, "laser y"),
@@ -601,6 +600,11 @@ LogScan ParseFlaser(const FieldParser& fields, std::size_t line, ReaderState& st
   scan.timestamp_s = fields.Number(p + 6, "ipc_timestamp");
   scan.logger_timestamp_s = fields.Number(p + 8, "logger_timestamp");
   ClassifyBeams(scan, state.log);
+  if (front) {
+    ++(FlaserSpacingOf(n) == FlaserSpacing::kFovOverBeams
+           ? state.log.flaser_scans_fov_over_beams
+           : state.log.flaser_scans_fov_over_beams_minus_one);
+  }
   // Only an accepted line notes how it read a PARAM, once per PARAM line.
   for (auto& [param_line, text] : notes) {
     if (state.noted_param_lines.insert(param_line).second) {
@@ -658,14 +662,16 @@ LogScan ParseRobotLaser(const FieldParser& fields, std::size_t line, ReaderState
   return scan;
 }
 
-// Adds the scan's beams to the log's counts (the first scan also gives the field of view).
-void CountBeams(const LogScan& scan, bool first, CarmenLog& log) {
+// Adds the scan's beams to the log's counts (the first scan also gives the field of view: first to
+// last bearing, plus one step unless its beams span first to last, FlaserSpacing).
+void CountBeams(const LogScan& scan, bool first, bool first_to_last, CarmenLog& log) {
   const std::size_t beams = scan.size();
   if (first) {
     log.beams_per_scan_min = log.beams_per_scan_max = beams;
     if (beams > 1) {
       const double span_rad = scan.angles_rad.back() - scan.angles_rad.front();
-      log.first_scan_field_of_view_rad = span_rad + span_rad / static_cast<double>(beams - 1);
+      log.first_scan_field_of_view_rad =
+          first_to_last ? span_rad : span_rad + span_rad / static_cast<double>(beams - 1);
     }
   }
   log.beams_per_scan_min = std::min(log.beams_per_scan_min, beams);
@@ -680,8 +686,8 @@ void ReleaseBeams(LogScan& scan) {
 }
 
 // Counts the scan's beams and keeps it, without its beams unless the options keep them.
-void AddScan(LogScan scan, ReaderState& state) {
-  CountBeams(scan, state.log.scans.empty(), state.log);
+void AddScan(LogScan scan, ReaderState& state, bool first_to_last = false) {
+  CountBeams(scan, state.log.scans.empty(), first_to_last, state.log);
   if (!state.options.keep_beams) ReleaseBeams(scan);
   state.log.scans.push_back(std::move(scan));
 }
@@ -700,7 +706,9 @@ void ParseLine(const std::string& path, std::size_t line_number,
   }
   const FieldParser fields(path, line_number, tokens, state.options.max_coordinate_m);
   if (type == "FLASER") {
-    AddScan(ParseFlaser(fields, line_number, state, true), state);
+    LogScan scan = ParseFlaser(fields, line_number, state, true);
+    const bool first_to_last = FlaserSpacingOf(scan.size()) == FlaserSpacing::kFovOverBeamsMinusOne;
+    AddScan(std::move(scan), state, first_to_last);
   } else if (type == "RLASER") {
     ParseFlaser(fields, line_number, state, false);  // validated and counted, not a front scan
   } else if (type == "ROBOTLASER1") {
@@ -791,7 +799,7 @@ void ReadLines(const std::string& path, LineReader& reader, ReaderState& state,
 // when the options say so.
 CarmenLog BagLog(CarmenLog log, const CarmenReadOptions& options) {
   for (std::size_t k = 0; k < log.scans.size(); ++k) {
-    CountBeams(log.scans[k], k == 0, log);
+    CountBeams(log.scans[k], k == 0, false, log);
     if (!options.keep_beams) ReleaseBeams(log.scans[k]);
   }
   return log;
@@ -812,6 +820,25 @@ std::string OutOfMemoryText(const std::string& path, std::size_t line_number, Re
 }
 
 }  // namespace
+
+FlaserSpacing FlaserSpacingOf(std::size_t beams) {
+  return beams % 2 == 1 && beams > 1 ? FlaserSpacing::kFovOverBeamsMinusOne
+                                     : FlaserSpacing::kFovOverBeams;
+}
+
+double FlaserSteps(std::size_t beams) {
+  const double n = static_cast<double>(beams);
+  return FlaserSpacingOf(beams) == FlaserSpacing::kFovOverBeamsMinusOne ? n - 1.0 : n;
+}
+
+double FlaserBeamAngle(std::size_t i, std::size_t beams, double fov_rad) {
+  if (beams == 0) return -0.5 * fov_rad;
+  return -0.5 * fov_rad + static_cast<double>(i) * (fov_rad / FlaserSteps(beams));
+}
+
+std::string ToString(FlaserSpacing spacing) {
+  return spacing == FlaserSpacing::kFovOverBeams ? "fov/n" : "fov/(n-1)";
+}
 
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
   if (!(options.flaser_max_range_m > 0.0)) {

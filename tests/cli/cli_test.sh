@@ -20,6 +20,15 @@ done
 check "info" "$keyplace" info "$log" --json "$work/info.json"
 check "info scans" test "$(json_value "$work/info.json" scans)" = 1464
 check "info beams" test "$(json_value "$work/info.json" beams_per_scan_max)" = 360
+# FLASER lines state no angles: info says how their beams were spread (odd counts first to last).
+python3 -c "print('FLASER 181 ' + ' '.join(['2.0'] * 181) + ' 0 0 0 0 0 0 1 h 1')" >"$work/odd.log"
+check "info on 181 FLASER beams" "$keyplace" info "$work/odd.log" --json "$work/odd.json"
+check "info names the odd-count spacing" grep -q "beam spacing    step fov/(n-1), first and last beam" "$work/out"
+check "info json spacing rule" python3 -c "
+import json,sys; s=json.load(open(sys.argv[1]))['flaser_beam_spacing']
+assert s == {'rule': 'fov/(n-1)', 'scans_fov_over_n': 0, 'scans_fov_over_n_minus_1': 1}, s" "$work/odd.json"
+check "info json no FLASER spacing for ROBOTLASER1" python3 -c "
+import json,sys; assert json.load(open(sys.argv[1]))['flaser_beam_spacing'] is None" "$work/info.json"
 
 check "features" "$keyplace" features "$log" --scans 0:20 --tsv "$work/kp.tsv" --json "$work/kp.json"
 check "features tsv header" test "$(head -1 "$work/kp.tsv")" = "$(printf 'scan\tx\ty\torientation\tscale')"

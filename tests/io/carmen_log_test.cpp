@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -95,6 +96,39 @@ TEST(CarmenLog, FieldOfViewFromParam) {
   ASSERT_EQ(log.scans.size(), 1u);
   EXPECT_NEAR(log.scans[0].angles_rad[0], -50.0 * M_PI / 180.0, 1e-12);
   EXPECT_NEAR(log.scans[0].angles_rad[1] - log.scans[0].angles_rad[0], 10.0 * M_PI / 180.0, 1e-12);
+}
+
+TEST(CarmenLog, EvenBeamCountsKeepFlirtLibsSpacingOddOnesSpanFirstToLastBeam) {
+  // Even counts: n steps of 180/n from -90 degrees, FLIRTLib's convention (the last beam at
+  // 90 - 180/n). Odd counts (SICK at 1 or 0.5 degrees): first and last beam at -90 and +90.
+  for (const auto& [beams, step_deg, last_deg] :
+       {std::make_tuple(180, 1.0, 89.0), std::make_tuple(360, 0.5, 89.5),
+        std::make_tuple(181, 1.0, 90.0), std::make_tuple(361, 0.5, 90.0)}) {
+    const std::string path = WriteText(
+        "spacing_" + std::to_string(beams) + ".log",
+        Flaser(beams, "1.0", "0 0 0 0 0 0 1 h 1") + Flaser(beams, "1.0", "0 0 0 0 0 0 2 h 2"));
+    const CarmenLog log = ReadCarmenLog(path);
+    ASSERT_EQ(log.scans.size(), 2u) << path;
+    const std::vector<double>& angles = log.scans[1].angles_rad;
+    EXPECT_NEAR(angles.front(), -M_PI / 2.0, 1e-12) << beams;
+    EXPECT_NEAR(angles[1] - angles[0], step_deg * M_PI / 180.0, 1e-12) << beams;
+    EXPECT_NEAR(angles.back(), last_deg * M_PI / 180.0, 1e-12) << beams;
+    EXPECT_NEAR(log.first_scan_field_of_view_rad, M_PI, 1e-12) << beams;
+    const bool odd = beams % 2 == 1;
+    EXPECT_EQ(log.flaser_scans_fov_over_beams, odd ? 0u : 2u) << beams;
+    EXPECT_EQ(log.flaser_scans_fov_over_beams_minus_one, odd ? 2u : 0u) << beams;
+  }
+  EXPECT_EQ(FlaserSpacingOf(181), FlaserSpacing::kFovOverBeamsMinusOne);
+  EXPECT_EQ(FlaserSpacingOf(1), FlaserSpacing::kFovOverBeams);  // one beam has no span
+  EXPECT_DOUBLE_EQ(FlaserBeamAngle(0, 1, M_PI), -M_PI / 2.0);
+  // A resolution alone: the step is the resolution in both conventions.
+  const std::string resolution =
+      WriteText("spacing_resolution.log", "PARAM laser_front_laser_resolution 0.5 nohost 0\n" +
+                                              Flaser(361, "1", "0 0 0 0 0 0 1 h 1"));
+  const CarmenLog log = ReadCarmenLog(resolution);
+  EXPECT_TRUE(log.warnings.empty());
+  EXPECT_NEAR(log.scans[0].angles_rad.front(), -M_PI / 2.0, 1e-12);
+  EXPECT_NEAR(log.scans[0].angles_rad.back(), M_PI / 2.0, 1e-12);
 }
 
 TEST(CarmenLog, BadBeamsAreMarkedInvalidAndCounted) {
@@ -282,8 +316,10 @@ TEST(CarmenLog, FieldOfViewResolutionAndBeamCountMustAgree) {
     const CarmenLog log = ReadCarmenLog(path);
     ASSERT_EQ(log.scans.size(), 1u) << path;
     EXPECT_TRUE(log.warnings.empty()) << path;
-    // The field of view decides the angles, spread as FLIRTLib does.
+    // The field of view decides the angles, spread by the convention of the beam count.
     EXPECT_NEAR(log.scans[0].angles_rad[0], -0.5 * std::stod(fov) * M_PI / 180.0, 1e-12);
+    EXPECT_NEAR(log.scans[0].angles_rad.back(),
+                (beams % 2 == 1 ? 0.5 : 0.5 - 1.0 / beams) * std::stod(fov) * M_PI / 180.0, 1e-12);
   }
   // Half the beams, ten beams too many (1 % + half a step is 2.3 here), a resolution twice too
   // fine.

@@ -39,6 +39,21 @@ struct GraphEdge {
   bool loop = false;  // listed after a "#LOOP EDGES" comment
 };
 
+/// How the beams of a FLASER / RLASER line, which states no angles, spread over its field of
+/// view. An even count keeps FLIRTLib's convention: each beam owns a sector, n steps of fov / n
+/// from -fov / 2 (CARMEN's 180- and 360-beam logs, FLIRTLib's reference output). An odd count
+/// (181, 361) is a SICK scanner at 1 or 0.5 degrees whose first and last beams lie at -fov / 2
+/// and +fov / 2: n - 1 steps of fov / (n - 1). Spreading 361 such beams by fov / 361 shrinks
+/// every step by 0.3 % and leaves the last beam 0.5 degrees short of +90.
+enum class FlaserSpacing { kFovOverBeams, kFovOverBeamsMinusOne };
+FlaserSpacing FlaserSpacingOf(std::size_t beams);
+/// The steps of the field of view between first and one-past-last beam: n or n - 1.
+double FlaserSteps(std::size_t beams);
+/// Bearing of beam i of a FLASER line of `beams` beams over fov_rad, by FlaserSpacingOf(beams).
+double FlaserBeamAngle(std::size_t i, std::size_t beams, double fov_rad);
+/// "fov/n" or "fov/(n-1)".
+std::string ToString(FlaserSpacing spacing);
+
 /// A scan as a CARMEN log gives it: the sensor data plus what the log writes beside it.
 struct LogScan : LaserScan {
   double logger_timestamp_s = 0.0;  // logger_timestamp (the monotonic one for Intel raw)
@@ -86,6 +101,10 @@ struct CarmenLog {
   std::size_t beams_per_scan_min = 0;
   std::size_t beams_per_scan_max = 0;
   double first_scan_field_of_view_rad = 0.0;
+  // FLASER lines read with each beam spacing (FlaserSpacing): even beam counts fov / n, odd ones
+  // fov / (n - 1). Both 0 for a log without FLASER lines (ROBOTLASER1 and bags state their angles).
+  std::size_t flaser_scans_fov_over_beams = 0;
+  std::size_t flaser_scans_fov_over_beams_minus_one = 0;
   std::size_t invalid_beams = 0;    // beams marked invalid because of NaN/inf/negative values
   std::size_t no_return_beams = 0;  // beams at or beyond max range (normal "no echo")
   // True when the scans' poses are SLAM-corrected (VERTEX2 or NEFF lines present): they are then
