@@ -180,6 +180,11 @@ nlohmann::json DescribeMap(const std::string& path, const GlobalMap& map) {
   json["scans_per_submap"] = stats.scans_per_submap;
   json["keypoints_per_submap"] = stats.keypoints_per_submap;
   json["distribution"] = stats.distribution;
+  json["median_path_m"] = stats.median_path_m;
+  json["max_path_m"] = stats.max_path_m;
+  json["path_bound_submaps"] = stats.path_bound_submaps;
+  json["median_extent_m"] = stats.median_extent_m;
+  json["max_extent_m"] = stats.max_extent_m;
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   bool first = true;
   for (const auto& submap : map.submaps) {
@@ -220,6 +225,11 @@ void PrintMap(const nlohmann::json& json) {
   fmt::print("scans per submap     {:.2f}\n", json["scans_per_submap"].get<double>());
   fmt::print("keypoints per submap {:.2f}\n", json["keypoints_per_submap"].get<double>());
   fmt::print("distribution         {:.3f}\n", json["distribution"].get<double>());
+  fmt::print("submap path          median {:.2f} m, largest {:.2f} m ({} reached the bound)\n",
+             json["median_path_m"].get<double>(), json["max_path_m"].get<double>(),
+             json["path_bound_submaps"].get<std::size_t>());
+  fmt::print("submap extent        median {:.2f} m, largest {:.2f} m\n",
+             json["median_extent_m"].get<double>(), json["max_extent_m"].get<double>());
   fmt::print("trajectory extent    {:.1f} m x {:.1f} m\n",
              json["trajectory_extent_m"][0].get<double>(),
              json["trajectory_extent_m"][1].get<double>());

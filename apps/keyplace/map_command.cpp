@@ -71,6 +71,10 @@ void PrintMapReport(const MapOptions& options, const LogInputs& inputs, const Lo
              stats.compression, stats.stable_keypoints, stats.source_keypoints,
              100.0 * (1.0 - stats.compression));
   fmt::print("distribution         {:.3f}\n", stats.distribution);
+  fmt::print("submap path          median {:.2f} m, largest {:.2f} m ({} reached the bound)\n",
+             stats.median_path_m, stats.max_path_m, stats.path_bound_submaps);
+  fmt::print("submap extent        median {:.2f} m, largest {:.2f} m\n", stats.median_extent_m,
+             stats.max_extent_m);
   fmt::print("time per submap      {:.4f} s mapping, {:.4f} s with poses and keypoints\n",
              result.seconds_per_submap_mapping, result.seconds_per_submap);
   fmt::print(
@@ -120,6 +124,11 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   json["distribution"] = stats.distribution;
   json["submaps"] = stats.submaps;
   json["forced_submaps"] = stats.forced_submaps;
+  json["median_path_m"] = stats.median_path_m;
+  json["max_path_m"] = stats.max_path_m;
+  json["path_bound_submaps"] = stats.path_bound_submaps;
+  json["median_extent_m"] = stats.median_extent_m;
+  json["max_extent_m"] = stats.max_extent_m;
   json["stable_keypoints"] = stats.stable_keypoints;
   json["source_keypoints"] = stats.source_keypoints;
   json["seconds_per_submap"] = result.seconds_per_submap;

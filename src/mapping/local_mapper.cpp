@@ -92,9 +92,12 @@ void LocalMapper::Reset() {
   initial_cells_ = 0;
   overlap_ = 1.0;
   distribution_ = 1.0;
+  path_m_ = 0.0;
+  extent_m_ = 0.0;
   complete_ = false;
   forced_ = false;
   grid_limited_ = false;
+  path_limited_ = false;
 }
 
 bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_world_robot,
@@ -159,6 +162,11 @@ bool LocalMapper::AddScan(int scan_index, const LaserScan& scan, const Pose2& T_
     complete_ = true;
     forced_ = true;
     return complete_;
+  }
+  if (!first) {
+    path_m_ += (T_world_robot.translation() - poses_.back().translation()).norm();
+    extent_m_ =
+        std::max(extent_m_, (T_world_robot.translation() - T_world_submap.translation()).norm());
   }
   scan_indices_.push_back(scan_index);
   poses_.push_back(T_world_robot);
@@ -236,6 +244,10 @@ void LocalMapper::UpdateCompletion() {
   complete_ = overlap_ < config_.min_overlap &&
               (!config_.use_distribution || distribution_ <= config_.max_distribution) &&
               static_cast<int>(stable_.size()) >= config_.min_stable_keypoints;
+  if (!complete_ && config_.max_path_m > 0.0 && path_m_ >= config_.max_path_m) {
+    complete_ = true;
+    path_limited_ = true;
+  }
   if (!complete_ && config_.max_scans_per_submap > 0 &&
       static_cast<int>(poses_.size()) >= config_.max_scans_per_submap) {
     complete_ = true;

@@ -33,6 +33,8 @@ void Validate(const MappingConfig& config) {
               config.distribution_cell_m <= kMaxDistributionCellM,
           "distribution_cell_m", "must lie in [0.01, 100] m (docs/MAPPING.md)");
   Require(config.min_stable_keypoints >= 0, "min_stable_keypoints", "must be >= 0");
+  Require(std::isfinite(config.max_path_m) && config.max_path_m >= 0.0, "max_path_m",
+          "must be finite and >= 0 (0 = no bound)");
   Require(config.max_scans_per_submap >= 0, "max_scans_per_submap", "must be >= 0");
   Require(config.max_grid_cells >= 1 && config.max_grid_cells <= kMaxGridCellsLimit,
           "max_grid_cells", "must lie in [1, 2^28] (docs/MAPPING.md)");
@@ -80,6 +82,8 @@ const ConfigFields<MappingConfig>& MappingConfigFields() {
               "what the binary histograms of delta are divided by")
         .Int("min_stable_keypoints", &C::min_stable_keypoints, "",
              "a complete submap holds at least this many stable keypoints")
+        .Double("max_path_m", &C::max_path_m, "m",
+                "a submap is also complete once its path length reaches this (0 = no bound)")
         .Int("max_scans_per_submap", &C::max_scans_per_submap, "",
              "close a submap after this many scans anyway (0 = never)")
         .Int("max_grid_cells", &C::max_grid_cells, "",
@@ -97,6 +101,11 @@ std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig
 void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config) {
   MappingConfigFields().Apply(values, config);
   Validate(config);
+}
+
+void ApplyStoredKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config) {
+  if (values.count("max_path_m") == 0) config.max_path_m = 0.0;
+  ApplyKeyValues(values, config);
 }
 
 }  // namespace keyplace

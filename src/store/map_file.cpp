@@ -295,7 +295,7 @@ class MapReader {
       config[row.Text(1, "key")] = row.Text(2, "value");
     }
     try {
-      ApplyKeyValues(config, map.config);
+      ApplyStoredKeyValues(config, map.config);
     } catch (const std::invalid_argument& error) {
       Fail(std::string("table config: ") + error.what());
     }

@@ -34,6 +34,14 @@ struct MappingStats {
   double distribution = 0.0;          // mean delta
   std::size_t submaps = 0;
   std::size_t forced_submaps = 0;  // closed by max_scans_per_submap
+  // How far each submap reaches in space (SubmapPathM, SubmapExtentM): medians and largest.
+  double median_path_m = 0.0;
+  double median_extent_m = 0.0;
+  double max_path_m = 0.0;
+  double max_extent_m = 0.0;
+  // Submaps whose path reached the map's MappingConfig::max_path_m (closed by the bound, unless
+  // the paper's criteria were met on the same scan).
+  std::size_t path_bound_submaps = 0;
   std::size_t stable_keypoints = 0;
   std::size_t source_keypoints = 0;
   // The whole configuration that made the map, as YAML (keyplace dump-config); empty when the
@@ -42,5 +50,10 @@ struct MappingStats {
 };
 
 MappingStats ComputeStats(const GlobalMap& map);
+
+/// Path length of the robot over a submap's poses, and the largest distance of one of its robot
+/// positions from the first (its extent).
+double SubmapPathM(const Submap& submap);
+double SubmapExtentM(const Submap& submap);
 
 }  // namespace keyplace

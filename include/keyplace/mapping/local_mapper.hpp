@@ -47,6 +47,12 @@ class LocalMapper {
   double distribution() const { return distribution_; }
   bool complete() const { return complete_; }
   bool forced() const { return forced_; }
+  /// Robot path length since the submap's first scan, and the largest distance of a robot
+  /// position from the first one (never more than the path length).
+  double path_m() const { return path_m_; }
+  double extent_m() const { return extent_m_; }
+  /// The submap was completed by MappingConfig::max_path_m, not by the paper's criteria.
+  bool path_limited() const { return path_limited_; }
   /// The submap was closed because a scan did not fit in max_grid_cells (then also forced()).
   bool grid_limited() const { return grid_limited_; }
   const StabilityGrid& grid() const { return grid_; }
@@ -69,9 +75,12 @@ class LocalMapper {
   std::int64_t initial_cells_ = 0;
   double overlap_ = 1.0;
   double distribution_ = 1.0;
+  double path_m_ = 0.0;
+  double extent_m_ = 0.0;
   bool complete_ = false;
   bool forced_ = false;
   bool grid_limited_ = false;
+  bool path_limited_ = false;
 };
 
 }  // namespace keyplace

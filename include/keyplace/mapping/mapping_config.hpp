@@ -46,6 +46,12 @@ struct MappingConfig {
   enum class DistributionNormalization { kPoints, kCells };
   DistributionNormalization distribution_normalization = DistributionNormalization::kPoints;
   int min_stable_keypoints = 10;  // and at least this many stable keypoints (Section 5.2)
+  // Absent from the paper: a submap is also complete once the robot has travelled this far since
+  // its first scan (its path length, which bounds its extent: no pose lies farther than this
+  // from the origin), whatever rho, delta and the keypoint count say. In open halls delta stays
+  // above delta_max for tens of metres; on FR079 and Intel every submap the criteria close is
+  // shorter than this (docs/MAPPING.md). 0 = no bound.
+  double max_path_m = 8.0;
   // Safety net absent from the paper: a submap that has not met the criteria after this many
   // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
   // submap that cannot be completed, as in the paper).
@@ -89,5 +95,10 @@ std::vector<std::pair<std::string, std::string>> ToKeyValues(const MappingConfig
 /// Sets the named fields of `config` from text. Throws std::invalid_argument naming the key for
 /// an unknown key or a value that does not parse. The result is validated.
 void ApplyKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config);
+
+/// ApplyKeyValues for the configuration recorded in a map file: a setting added after the map
+/// was written (absent from `values`) takes the value that reproduces how the map was built
+/// (max_path_m = 0, no bound), so that its queries complete as its submaps did.
+void ApplyStoredKeyValues(const std::map<std::string, std::string>& values, MappingConfig& config);
 
 }  // namespace keyplace
