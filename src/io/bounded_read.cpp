@@ -28,8 +28,11 @@ std::string ReadWholeFile(const std::string& path, std::size_t max_bytes, const 
     in.read(content.data() + at, static_cast<std::streamsize>(want));
     content.resize(at + static_cast<std::size_t>(in.gcount()));
     if (content.size() > max_bytes) {
-      throw std::runtime_error(path + ": larger than " + Size(max_bytes) + ", the limit of a " +
-                               what + " (not read further; is it the right file?)");
+      std::string message = path;
+      message += ": larger than " + Size(max_bytes);
+      message += ", the limit of a " + what;
+      message += " (not read further; is it the right file?)";
+      throw std::runtime_error(message);
     }
   }
   if (in.bad()) throw std::runtime_error(path + ": read error in the " + what);

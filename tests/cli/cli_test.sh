@@ -79,6 +79,9 @@ check "info on coarse stamps" "$keyplace" info "$work/coarse.log"
 cp "$work/out" "$work/coarse-info.txt"
 check "info warns" grep -q "cannot order the scans" "$work/coarse-info.txt"
 fails_with "odometry refuses coarse stamps" "--order file" "$keyplace" odometry "$work/coarse.log"
+# ... naming the log (issue 31), as slam's refusal does.
+fails_with "odometry's refusal names the log" "$work/coarse.log: the logger timestamps cannot order" \
+  "$keyplace" odometry "$work/coarse.log"
 check "odometry --order file" "$keyplace" odometry "$work/coarse.log" --order file
 fails_with "slam refuses coarse stamps" "--order file" "$keyplace" slam "$work/coarse.log"
 

@@ -594,6 +594,23 @@ TEST(Ros2Bag, ScanAnglesBeyondOneTurnAreRefused) {
   EXPECT_EQ(ReadRos2Bag(bag).scans.size(), 150u);
 }
 
+// Issue 31: an MCAP channel with schema_id 0 ("no schema") was shown with an empty type.
+TEST(Ros2Bag, AChannelWithoutSchemaIsShownAsSuch) {
+  const std::string bag = CopyFixture("mcap-none");
+  const std::string file = bag + "/mcap-none_0.mcap";
+  std::string bytes = ReadBytes(file);
+  // The first chunk (at byte 59) holds the /scan channel; its CRC (0 = unchecked) is cleared.
+  ASSERT_EQ(bytes[59], '\x06');
+  std::memset(bytes.data() + 59 + 9 + 24, 0, 4);
+  const std::size_t topic = bytes.find(std::string("\x05\x00\x00\x00/scan", 9));
+  ASSERT_NE(topic, std::string::npos);
+  std::memset(bytes.data() + topic - 2, 0, 2);  // schema_id, after the channel id
+  WriteBytes(file, bytes);
+  ExpectContains(ErrorOf(bag), bag +
+                                   ": topic /scan holds <no schema: schema_id 0> messages, not "
+                                   "sensor_msgs/msg/LaserScan");
+}
+
 // Issue 31: text in messages.timestamp read as 0 (SQLite converts what it is asked to).
 TEST(Ros2Bag, ATimestampThatIsNoIntegerIsRefused) {
   const std::string bag = CopyFixture("sqlite3");
