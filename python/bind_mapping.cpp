@@ -127,6 +127,14 @@ void BindStats(py::module_& module) {
       .def_readonly("distribution", &MappingStats::distribution, "Mean delta.")
       .def_readonly("submaps", &MappingStats::submaps)
       .def_readonly("forced_submaps", &MappingStats::forced_submaps)
+      .def_readonly("median_path_m", &MappingStats::median_path_m,
+                    "Median robot path length over a submap's scans.")
+      .def_readonly("max_path_m", &MappingStats::max_path_m)
+      .def_readonly("median_extent_m", &MappingStats::median_extent_m,
+                    "Median largest distance of a submap's pose from its first.")
+      .def_readonly("max_extent_m", &MappingStats::max_extent_m)
+      .def_readonly("path_bound_submaps", &MappingStats::path_bound_submaps,
+                    "Submaps whose path reached mapping.max_path_m.")
       .def_readonly("stable_keypoints", &MappingStats::stable_keypoints)
       .def_readonly("source_keypoints", &MappingStats::source_keypoints);
 }
