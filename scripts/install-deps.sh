@@ -15,6 +15,10 @@ packages=(
   # the tests' oracle and writes their bags (the library does not link it)
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libgeometry-msgs-dev
   libroslz4-dev libbz2-dev
+  # the ROS 1 nodes (ros/): roscpp, tf2_ros and the service and status messages; their live
+  # tests run a roscore (ros-core), rosbag play and a rospy subscriber
+  libroscpp-dev libtf2-ros-dev libstd-srvs-dev libdiagnostic-msgs-dev ros-core python3-rospy
+  python3-rosbag python3-geometry-msgs python3-diagnostic-msgs python3-std-srvs python3-nav-msgs
   # ROS 2 bags: MCAP chunk codecs (LZ4 frames, zstd); sqlite3 and yaml-cpp are above
   liblz4-dev libzstd-dev
   # the CLI tests read JSON with python3; the Python module's tests and example (Debian's

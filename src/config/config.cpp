@@ -27,7 +27,8 @@ const ConfigFields<Config>& ConfigTable() {
         .Nested("localization", &Config::localization, LocalizerConfigFields())
         .Nested("evaluation", &Config::evaluation, EvaluationConfigFields())
         .Nested("grid", &Config::grid, OccupancyGridConfigFields())
-        .Nested("merge", &Config::merge, MergeOptionsFields());
+        .Nested("merge", &Config::merge, MergeOptionsFields())
+        .Nested("node", &Config::node, NodeConfigFields());
     return table;
   }();
   return fields;
@@ -92,6 +93,7 @@ void ValidateSection(const std::string& section, const Config& config) {
   if (section == "evaluation") Validate(config.evaluation);
   if (section == "grid") Validate(config.grid);
   if (section == "merge") Validate(config.merge);
+  if (section == "node") Validate(config.node);
 }
 
 std::string SectionOf(const std::string& key) { return key.substr(0, key.find('.')); }
@@ -260,6 +262,7 @@ void Validate(const Config& config) {
   Validate(config.evaluation);
   Validate(config.grid);
   Validate(config.merge);
+  Validate(config.node);
 }
 
 std::vector<ConfigFieldInfo> DescribeConfig(const Config& config) {

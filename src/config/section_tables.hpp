@@ -8,6 +8,7 @@
 #include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/localization/map_merge.hpp"
+#include "keyplace/localization/node_config.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -33,5 +34,6 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields();
 const ConfigFields<OccupancyGridConfig>& OccupancyGridConfigFields();
 const ConfigFields<MergeOptions>& MergeOptionsFields();
 const ConfigFields<BagInputConfig>& BagInputConfigFields();
+const ConfigFields<NodeConfig>& NodeConfigFields();
 
 }  // namespace keyplace

@@ -13,6 +13,7 @@
 #include "keyplace/io/bag_input_config.hpp"
 #include "keyplace/localization/global_localizer.hpp"
 #include "keyplace/localization/map_merge.hpp"
+#include "keyplace/localization/node_config.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/mapping/occupancy_grid.hpp"
 #include "keyplace/place/place_config.hpp"
@@ -33,6 +34,7 @@ struct Config {
   EvaluationConfig evaluation;   // evaluation settings (not the method's)
   OccupancyGridConfig grid;      // occupancy grids for navigation stacks (docs/NAVIGATION.md)
   MergeOptions merge;            // keyplace merge (docs/MERGE.md)
+  NodeConfig node;               // relocalization node on a robot (docs/ROS.md, "On a robot")
 };
 
 /// The SLAM configuration with the odometry, mapping and place sections put in.

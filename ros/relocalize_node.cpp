@@ -1,0 +1,278 @@
+// keyplace_ros_relocalize: the RelocalizationNode on ROS 1. Scans and odometry (a topic or the
+// tf chain) in; /initialpose, map -> odom on tf and the status on /diagnostics out; services
+// ~relocalize and ~save_status. Everything it decides comes from the library's node core; this
+// file only converts messages (docs/ROS.md, "On a robot").
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "keyplace/localization/relocalization_node.hpp"
+#include "keyplace/store/map_file.hpp"
+#include "ros_support.hpp"
+
+namespace keyplace::ros1 {
+namespace {
+
+std::string Text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g", value);
+  return text;
+}
+
+class RelocalizeNode {
+ public:
+  RelocalizeNode(ros::NodeHandle& node, ros::NodeHandle& private_node, const GlobalMap& map,
+                 const Config& config)
+      : core_(map, config), tf_listener_(tf_buffer_) {
+    const BagInputConfig& input = config.input;
+    scan_subscriber_ = node.subscribe(input.scan_topic, 200, &RelocalizeNode::OnScan, this);
+    if (config.node.odometry == NodeOdometry::kTopic) {
+      odom_subscriber_ = node.subscribe(input.odom_topic, 500, &RelocalizeNode::OnOdometry, this);
+    }
+    initial_pose_publisher_ =
+        node.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 5);
+    diagnostics_publisher_ = node.advertise<diagnostic_msgs::DiagnosticArray>("diagnostics", 10);
+    relocalize_service_ =
+        private_node.advertiseService("relocalize", &RelocalizeNode::OnRelocalize, this);
+    save_status_service_ =
+        private_node.advertiseService("save_status", &RelocalizeNode::OnSaveStatus, this);
+    timer_ = node.createTimer(ros::Duration(0.1), &RelocalizeNode::OnTimer, this);
+    const std::string odometry = config.node.odometry == NodeOdometry::kTopic
+                                     ? odom_subscriber_.getTopic()
+                                     : "tf " + input.odom_frame + " -> " + input.base_frame;
+    ROS_INFO("keyplace: relocalizing on %s with odometry from %s; publishing %s",
+             scan_subscriber_.getTopic().c_str(), odometry.c_str(),
+             PublishText(config.node.publish));
+  }
+
+  ~RelocalizeNode() {
+    const NodeStatus status = core_.status();
+    ROS_INFO(
+        "keyplace: %zu scans received, %zu processed, %zu dropped; per scan %.1f ms mean, "
+        "%.1f ms p99, %.1f ms max",
+        status.scans_received, status.scans_processed, status.scans_dropped,
+        1e3 * status.latency_mean_s, 1e3 * status.latency_p99_s, 1e3 * status.latency_max_s);
+  }
+
+ private:
+  static const char* PublishText(NodePublish publish) {
+    switch (publish) {
+      case NodePublish::kInitialPose:
+        return "/initialpose on each new fix";
+      case NodePublish::kMapToOdom:
+        return "map -> odom while fixed";
+      case NodePublish::kBoth:
+        return "/initialpose on each new fix and map -> odom while fixed";
+    }
+    return "?";
+  }
+
+  void OnScan(const sensor_msgs::LaserScan::ConstPtr& message) {
+    try {
+      const Config& config = core_.config();
+      ScanInput scan;
+      scan.stamp_s = message->header.stamp.toSec();
+      scan.frame_id = message->header.frame_id;
+      scan.angle_min_rad = message->angle_min;
+      scan.angle_increment_rad = message->angle_increment;
+      scan.range_min_m = message->range_min;
+      scan.range_max_m = message->range_max;
+      scan.ranges_m = message->ranges;
+      if (config.input.laser_pose.empty()) {
+        std::string error;
+        scan.T_robot_laser = LookupPose(tf_buffer_, config.input.base_frame, scan.frame_id,
+                                        message->header.stamp, ros::Duration(0.0), &error);
+        if (!scan.T_robot_laser) ROS_WARN_THROTTLE(5.0, "keyplace: laser pose: %s", error.c_str());
+      }
+      if (config.node.odometry == NodeOdometry::kTf) {
+        std::string error;
+        const std::optional<Pose2> T_odom_robot =
+            LookupPose(tf_buffer_, config.input.odom_frame, config.input.base_frame,
+                       message->header.stamp, ros::Duration(config.node.odometry_wait_s), &error);
+        if (T_odom_robot) {
+          Publish(core_.AddOdometry({scan.stamp_s, *T_odom_robot}));
+        } else {
+          ROS_WARN_THROTTLE(5.0, "keyplace: odometry from tf: %s", error.c_str());
+        }
+      }
+      Publish(core_.AddScan(scan));
+    } catch (const std::exception& error) {
+      ROS_ERROR("keyplace: scan: %s", error.what());
+    }
+  }
+
+  void OnOdometry(const nav_msgs::Odometry::ConstPtr& message) {
+    try {
+      const geometry_msgs::Point& p = message->pose.pose.position;
+      Publish(core_.AddOdometry(
+          {message->header.stamp.toSec(), Pose2(p.x, p.y, YawOf(message->pose.pose.orientation))}));
+    } catch (const std::exception& error) {
+      ROS_ERROR("keyplace: odometry: %s", error.what());
+    }
+  }
+
+  void OnTimer(const ros::TimerEvent&) {
+    try {
+      Publish(core_.Tick(ros::Time::now().toSec()));
+    } catch (const std::exception& error) {
+      ROS_ERROR("keyplace: %s", error.what());
+    }
+  }
+
+  bool OnRelocalize(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+    Publish(core_.Relocalize());
+    response.success = true;
+    response.message = "searching";
+    return true;
+  }
+
+  bool OnSaveStatus(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+    const std::string& path = core_.config().node.status_path;
+    try {
+      core_.SaveStatus(path);
+      response.success = true;
+      response.message = path;
+    } catch (const std::exception& error) {
+      response.success = false;
+      response.message = error.what();
+      ROS_ERROR("keyplace: ~save_status: %s", error.what());
+    }
+    return true;
+  }
+
+  void Publish(const NodeOutput& output) {
+    for (const NodeEvent& event : output.events) {
+      switch (event.level) {
+        case NodeEventLevel::kInfo:
+          ROS_INFO("keyplace: %s", event.what.c_str());
+          break;
+        case NodeEventLevel::kWarning:
+          ROS_WARN("keyplace: %s", event.what.c_str());
+          break;
+        case NodeEventLevel::kError:
+          ROS_ERROR("keyplace: %s", event.what.c_str());
+          break;
+      }
+    }
+    for (const StampedInitialPose& fix : output.initial_poses) PublishInitialPose(fix);
+    for (const StampedTransform& transform : output.transforms) PublishTransform(transform);
+    if (output.status_due) PublishStatus();
+  }
+
+  void PublishInitialPose(const StampedInitialPose& fix) {
+    geometry_msgs::PoseWithCovarianceStamped message;
+    message.header.stamp.fromSec(fix.stamp_s);
+    message.header.frame_id = fix.pose.frame_id;
+    message.pose.pose.position.x = fix.pose.T_map_robot.x;
+    message.pose.pose.position.y = fix.pose.T_map_robot.y;
+    message.pose.pose.orientation = QuaternionOf(fix.pose.T_map_robot.theta);
+    const std::array<double, 36> covariance = InitialPoseCovariance(fix.pose);
+    std::copy(covariance.begin(), covariance.end(), message.pose.covariance.begin());
+    initial_pose_publisher_.publish(message);
+  }
+
+  void PublishTransform(const StampedTransform& transform) {
+    geometry_msgs::TransformStamped message;
+    message.header.stamp.fromSec(transform.stamp_s);
+    message.header.frame_id = transform.parent_frame;
+    message.child_frame_id = transform.child_frame;
+    message.transform.translation.x = transform.T_parent_child.x;
+    message.transform.translation.y = transform.T_parent_child.y;
+    message.transform.rotation = QuaternionOf(transform.T_parent_child.theta);
+    tf_broadcaster_.sendTransform(message);
+  }
+
+  void PublishStatus() {
+    const NodeStatus status = core_.status();
+    diagnostic_msgs::DiagnosticStatus diagnostic;
+    diagnostic.name = ros::this_node::getName() + ": relocalization";
+    diagnostic.hardware_id = "keyplace";
+    diagnostic.level = status.status == FixStatus::kFixed ? diagnostic_msgs::DiagnosticStatus::OK
+                                                          : diagnostic_msgs::DiagnosticStatus::WARN;
+    diagnostic.message = ToString(status.status);
+    const auto value = [&](const std::string& key, const std::string& text) {
+      diagnostic_msgs::KeyValue entry;
+      entry.key = key;
+      entry.value = text;
+      diagnostic.values.push_back(entry);
+    };
+    value("status", ToString(status.status));
+    value("confidence", Text(status.confidence));
+    if (status.pose) {
+      value("x", Text(status.pose->T_map_robot.x));
+      value("y", Text(status.pose->T_map_robot.y));
+      value("theta", Text(status.pose->T_map_robot.theta));
+    }
+    if (status.last_answer) {
+      const NodeAnswer& answer = *status.last_answer;
+      value("last_answer_stamp", Text(answer.stamp_s));
+      value("last_answer", answer.found ? "found" : answer.ambiguous ? "ambiguous" : "not found");
+      value("last_answer_confidence", Text(answer.confidence));
+    }
+    value("scans_received", std::to_string(status.scans_received));
+    value("scans_processed", std::to_string(status.scans_processed));
+    value("scans_dropped", std::to_string(status.scans_dropped));
+    value("odometry_dropped", std::to_string(status.odometry_dropped));
+    value("answers", std::to_string(status.answers));
+    value("fixes", std::to_string(status.fixes));
+    value("losses", std::to_string(status.losses));
+    value("last_scan_stamp", Text(status.last_scan_stamp_s));
+    value("latency_mean_s", Text(status.latency_mean_s));
+    value("latency_p99_s", Text(status.latency_p99_s));
+    value("latency_max_s", Text(status.latency_max_s));
+    diagnostic_msgs::DiagnosticArray array;
+    array.header.stamp = ros::Time::now();
+    array.status.push_back(diagnostic);
+    diagnostics_publisher_.publish(array);
+  }
+
+  RelocalizationNode core_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  ros::Subscriber scan_subscriber_;
+  ros::Subscriber odom_subscriber_;
+  ros::Publisher initial_pose_publisher_;
+  ros::Publisher diagnostics_publisher_;
+  ros::ServiceServer relocalize_service_;
+  ros::ServiceServer save_status_service_;
+  ros::Timer timer_;
+};
+
+}  // namespace
+}  // namespace keyplace::ros1
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "keyplace_relocalize");
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  std::unique_ptr<keyplace::ros1::RelocalizeNode> relocalize;
+  try {
+    // A robot program relocalizes with the strict preset (docs/LOCALIZATION.md).
+    const keyplace::Config config = keyplace::ros1::ConfigFromParameters(private_node, "strict");
+    const std::string map_path = keyplace::ros1::RequiredParameter(private_node, "map");
+    const keyplace::GlobalMap map = keyplace::LoadMap(map_path);
+    ROS_INFO("keyplace: map %s: %zu submaps", map_path.c_str(), map.submaps.size());
+    relocalize = std::make_unique<keyplace::ros1::RelocalizeNode>(node, private_node, map, config);
+  } catch (const std::exception& error) {
+    ROS_FATAL("keyplace: %s", error.what());
+    return 2;
+  }
+  ros::spin();
+  relocalize.reset();
+  return 0;
+}

@@ -1,0 +1,65 @@
+#include "keyplace/localization/node_config.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "config/section_tables.hpp"
+
+namespace keyplace {
+namespace {
+
+// What InitialPoseYaml takes as a frame id: letters, digits, '_', '/', '.', '-'; not empty.
+bool IsFrameName(const std::string& name) {
+  if (name.empty()) return false;
+  for (const char c : name) {
+    const bool allowed = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                         (c >= '0' && c <= '9') || c == '_' || c == '/' || c == '.' || c == '-';
+    if (!allowed) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void Validate(const NodeConfig& config) {
+  const auto fail = [](const std::string& message) {
+    throw std::invalid_argument("NodeConfig." + message);
+  };
+  if (!IsFrameName(config.map_frame)) {
+    fail("map_frame '" + config.map_frame + "' is not a frame name (letters, digits, _ / . -)");
+  }
+  if (!(config.odometry_wait_s > 0.0 && config.odometry_wait_s <= 60.0)) {
+    fail("odometry_wait_s must be in (0, 60] s");
+  }
+  if (!(config.status_period_s > 0.0 && config.status_period_s <= 3600.0)) {
+    fail("status_period_s must be in (0, 3600] s");
+  }
+  if (config.status_path.empty()) fail("status_path must not be empty");
+}
+
+const ConfigFields<NodeConfig>& NodeConfigFields() {
+  using C = NodeConfig;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("NodeConfig");
+    table
+        .Enum("publish", &C::publish,
+              {{NodePublish::kInitialPose, "initialpose"},
+               {NodePublish::kMapToOdom, "map_to_odom"},
+               {NodePublish::kBoth, "both"}},
+              "relocalization node: /initialpose on each new fix, map -> odom while fixed, or both")
+        .Enum("odometry", &C::odometry,
+              {{NodeOdometry::kTopic, "topic"}, {NodeOdometry::kTf, "tf"}},
+              "odometry from input.odom_topic or from tf (input.odom_frame -> input.base_frame)")
+        .Text("map_frame", &C::map_frame, "", "frame of the map, the fixes and map -> odom")
+        .Double("odometry_wait_s", &C::odometry_wait_s, "s",
+                "a scan waits for odometry at its stamp until a scan this much newer comes")
+        .Double("status_period_s", &C::status_period_s, "s",
+                "the status (and map -> odom when fixed) goes out at least this often")
+        .Text("status_path", &C::status_path, "", "file ~save_status writes (YAML)");
+    return table;
+  }();
+  return fields;
+}
+
+}  // namespace keyplace
