@@ -78,7 +78,7 @@ bool IgnoredRemovedKey(const std::string& key, const std::string& value) {
 const std::vector<std::string>& SectionNames() {
   static const std::vector<std::string> names = {"input", "features", "odometry",     "mapping",
                                                  "place", "slam",     "localization", "evaluation",
-                                                 "grid",  "merge"};
+                                                 "grid",  "merge",    "node"};
   return names;
 }
 

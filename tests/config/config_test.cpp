@@ -97,7 +97,8 @@ TEST(Config, BadFilesNameFileLineAndKey) {
             "my.yaml:2: place.min_pairs: expected a value, found nothing");
   EXPECT_EQ(ErrorOfYaml("place:\n  min_pairs: [1, 2]\n"),
             "my.yaml:2: place.min_pairs: expected a value, found a list");
-  EXPECT_EQ(ErrorOfYaml("odometry: 3\n"), "my.yaml:1: unknown configuration key 'odometry'");
+  EXPECT_EQ(ErrorOfYaml("odometry: 3\n"),
+            "my.yaml:1: unknown configuration key 'odometry'; did you mean 'node.odometry'?");
   EXPECT_EQ(ErrorOfYaml("- 1\n- 2\n"), "my.yaml:1: the configuration: expected a mapping of keys");
   // Found by fuzzing (tests/fuzz/regressions/config_yaml): a key that is a list or a mapping
   // ended the program with yaml-cpp's bad conversion; an alias of a mapping inside itself
