@@ -62,9 +62,10 @@ class RelocalizeNode {
   ~RelocalizeNode() {
     const NodeStatus status = core_.status();
     ROS_INFO(
-        "keyplace: %zu scans received, %zu processed, %zu dropped; per scan %.1f ms mean, "
+        "keyplace: %zu scans received, %zu processed, %zu dropped, %zu waiting; per scan %.1f ms "
+        "mean, "
         "%.1f ms p99, %.1f ms max",
-        status.scans_received, status.scans_processed, status.scans_dropped,
+        status.scans_received, status.scans_processed, status.scans_dropped, status.scans_waiting,
         1e3 * status.latency_mean_s, 1e3 * status.latency_p99_s, 1e3 * status.latency_max_s);
   }
 
@@ -226,6 +227,7 @@ class RelocalizeNode {
     value("scans_received", std::to_string(status.scans_received));
     value("scans_processed", std::to_string(status.scans_processed));
     value("scans_dropped", std::to_string(status.scans_dropped));
+    value("scans_waiting", std::to_string(status.scans_waiting));
     value("odometry_dropped", std::to_string(status.odometry_dropped));
     value("answers", std::to_string(status.answers));
     value("fixes", std::to_string(status.fixes));

@@ -370,6 +370,7 @@ void RelocalizationNode::Drop(const std::string& why, NodeOutput& output) {
 
 NodeStatus RelocalizationNode::status() const {
   NodeStatus status = status_;
+  status.scans_waiting = pending_.size();
   if (!latencies_s_.empty()) {
     const std::vector<double> latencies(latencies_s_.begin(), latencies_s_.end());
     double sum_s = 0.0;
@@ -408,6 +409,7 @@ std::string RelocalizationNode::StatusYaml() const {
   yaml << "scans_received: " << s.scans_received << "\n";
   yaml << "scans_processed: " << s.scans_processed << "\n";
   yaml << "scans_dropped: " << s.scans_dropped << "\n";
+  yaml << "scans_waiting: " << s.scans_waiting << "\n";
   yaml << "odometry_dropped: " << s.odometry_dropped << "\n";
   yaml << "answers: " << s.answers << "\n";
   yaml << "fixes: " << s.fixes << "\n";

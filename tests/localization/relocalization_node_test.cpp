@@ -230,6 +230,7 @@ TEST(RelocalizationNode, AScanWaitsForOdometryAtItsStampAndIsDroppedWhenALaterOn
   node.AddScan(ScanMessage(k + 1));
   output = node.Tick(ScanMessage(k + 1).stamp_s + 10.0);
   EXPECT_TRUE(output.events.empty());
+  EXPECT_EQ(node.status().scans_waiting, 1U);
   EXPECT_TRUE(output.status_due) << "the status goes out every node.status_period_s";
   ASSERT_LT(ScanMessage(k + 2).stamp_s - ScanMessage(k + 1).stamp_s, 1.0);
   EXPECT_TRUE(node.AddScan(ScanMessage(k + 2)).events.empty());
@@ -238,9 +239,13 @@ TEST(RelocalizationNode, AScanWaitsForOdometryAtItsStampAndIsDroppedWhenALaterOn
   ASSERT_EQ(output.events.size(), 1U);
   testing::ExpectContains(output.events.front().what, "no odometry at its stamp");
   EXPECT_EQ(node.status().scans_dropped, 1U);
+  EXPECT_EQ(node.status().scans_waiting, 2U);
   // The odometry comes back: the scans still waiting are processed.
   output = node.AddOdometry(OdometryMessage(k + 3));
   EXPECT_EQ(output.scans.size(), 2U);
+  const NodeStatus status = node.status();
+  EXPECT_EQ(status.scans_waiting, 0U);
+  EXPECT_EQ(status.scans_received, status.scans_processed + status.scans_dropped);
 }
 
 TEST(RelocalizationNode, ScansBehindTheOdometryAreProcessedInTheirOrder) {

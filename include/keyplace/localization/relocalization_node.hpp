@@ -93,6 +93,8 @@ struct NodeStatus {
   std::size_t scans_received = 0;
   std::size_t scans_processed = 0;
   std::size_t scans_dropped = 0;
+  // Accepted and waiting for odometry at their stamp: received = processed + dropped + waiting.
+  std::size_t scans_waiting = 0;
   std::size_t odometry_dropped = 0;
   std::size_t answers = 0;
   std::size_t fixes = 0;   // fixes declared (first ones and new ones after a loss)
