@@ -2,10 +2,12 @@
 // map A, found by place recognition of B's submaps, and the two joined in A's frame.
 
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -144,6 +146,11 @@ void RunMerge(const CLI::App& command, const MergeCommandOptions& options) {
   CheckOutputs(command, {{"--out", options.out_path}, {"--json", options.json_path}});
   if (options.log_path.empty() && !(options.truth_path.empty() && options.index_path.empty())) {
     throw std::invalid_argument("--truth and --index need --log (the log the maps were made from)");
+  }
+  std::error_code same_error;
+  if (std::filesystem::equivalent(options.map_a, options.map_b, same_error)) {
+    throw std::invalid_argument(options.map_b + ": is the same file as " + options.map_a +
+                                "; merging a map with itself adds nothing");
   }
   const Config config = ResolveConfig(options.config);
   const GlobalMap a = LoadMap(options.map_a);

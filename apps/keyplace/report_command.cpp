@@ -8,6 +8,8 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -24,6 +26,18 @@ namespace fs = std::filesystem;
 std::string DefaultDataDir() {
   const char* shared = std::getenv("KEYPLACE_SHARED");
   return shared != nullptr ? (fs::path(shared) / "data").string() : std::string("../shared/data");
+}
+
+// The files of the data directory: the logs and relation files the report reads, which --json
+// must not replace.
+std::vector<std::string> DataFiles(const std::string& data_dir) {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (fs::directory_iterator entry(data_dir, error), end; !error && entry != end;
+       entry.increment(error)) {
+    files.push_back(entry->path().string());
+  }
+  return files;
 }
 
 // --json: what the report ran and where the page is.
@@ -60,7 +74,7 @@ nlohmann::json ReportJson(const ReportOptions& options, const ReportSummary& sum
 int Report(const CLI::App& command, ReportOptions options, const std::string& json_path) {
   const auto start = std::chrono::steady_clock::now();
   if (options.data_dir.empty()) options.data_dir = DefaultDataDir();
-  CheckOutputs(command, {{"--json", json_path}});
+  CheckOutputs(command, {{"--json", json_path}}, DataFiles(options.data_dir));
   CheckNotReserved("--json", json_path, {options.out_dir + "/index.html"}, "the report's page");
   // This very executable, even if its file is replaced by a rebuild while the report runs.
   const ReportSummary summary = RunReport(options, "/proc/self/exe");

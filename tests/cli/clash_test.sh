@@ -86,6 +86,9 @@ refused "merge --json onto --log" small.log merge "$M" @IN@/other.kpm --out @IN@
 refused "sweep mapping --json" small.log sweep mapping --log "$L" --out @IN@/sweep --json @
 refused "sweep place --json" small.log sweep place --map-log "$L" --out @IN@/sweep --json @
 refused "dump-config --json" config.yaml dump-config --config "$C" --json @
+# The report reads its logs from --data: a file there is an input though no option names it.
+refused "report --json onto a file of --data" small.log report --data @IN@ --out @IN@/report \
+  --no-run --json @
 
 # A file of an input rosbag2 directory (its metadata.yaml, its storage files).
 cp -r "$source_dir/tests/data/ros2/mcap-none" bagdir
@@ -97,6 +100,12 @@ if [ -f bagdir/metadata.yaml ]; then
 else
   fail "the rosbag2 fixture tests/data/ros2/mcap-none has no metadata.yaml"
 fi
+
+# The same map twice (by another name too) is refused before any work; a copy is another map.
+ln -s small.kpm pristine/link.kpm
+fails_with "merge A A" "is the same file as" "$keyplace" merge pristine/small.kpm \
+  pristine/link.kpm --out merged.kpm
+check "merge A A writes nothing" test ! -e merged.kpm
 
 # A missing input is a usage error with the usual status 1 (CLI11's own code was 105).
 "$keyplace" info "$work/missing.log" >/dev/null 2>missing.err

@@ -204,5 +204,49 @@ TEST(Ros1BagWritten, AScanOnTheOdometryTopicIsAnErrorNamingBoth) {
                                     "nav_msgs/Odometry");
 }
 
+// Issue 31: a frame id of a megabyte was printed whole (1.35 GB of messages). Frame ids longer
+// than 1024 bytes are refused, the message showing the start only.
+TEST(Ros1BagWritten, AFrameIdOfAMegabyteIsRefusedAndShownShort) {
+  const std::string huge(std::size_t{1} << 20, 'f');
+  for (const bool in_tf : {false, true}) {
+    const std::string path = testing::MakeTempDir("frame") + "/frame.bag";
+    {
+      rosbag::Bag bag(path, rosbag::bagmode::Write);
+      bag.write("/tf_static", ros::Time(10.0),
+                Transform(10.0, "base_link", in_tf ? huge : "laser", 0.1, 0.2, 0.5));
+      bag.write("/odom", ros::Time(10.0), Odometry(10.0, 0.0, 0.0, 0.0));
+      bag.write("/odom", ros::Time(12.0), Odometry(12.0, 1.0, 0.0, 0.0));
+      bag.write("/scan", ros::Time(11.0), Scan(11.0, in_tf ? "laser" : huge));
+    }
+    const std::string error = ErrorOf(path);
+    ExpectContains(error, "is longer than 1024 bytes: not a frame id");
+    EXPECT_LT(error.size(), 600U) << (in_tf ? "tf" : "scan");
+  }
+}
+
+// Names and frames listed in a message come from the bag: at most 20 of them are shown.
+TEST(Ros1BagWritten, ListsOfTopicsAndTransformsStopAtTwenty) {
+  const std::string path = testing::MakeTempDir("lists") + "/lists.bag";
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    for (int i = 0; i < 30; ++i) {
+      const std::string name = "frame" + std::to_string(100 + i);
+      bag.write("/topic" + std::to_string(100 + i), ros::Time(10.0), Odometry(10.0, 0.0, 0.0, 0.0));
+      bag.write("/tf_static", ros::Time(10.0), Transform(10.0, "base_link", name, 0, 0, 0));
+    }
+    bag.write("/scan", ros::Time(11.0), Scan(11.0, "frame100"));
+  }
+  const std::string error = ErrorOf(path);  // no odometry: names topics and transforms
+  ExpectContains(error, "no odometry");
+  ExpectContains(error, ", and 12 more");  // 32 topics: /scan, /tf_static and the 30
+  ExpectContains(error, ", and 10 more");  // 30 transforms
+  std::size_t listed_frames = 0;
+  for (std::size_t at = error.find("base_link -> frame"); at != std::string::npos;
+       at = error.find("base_link -> frame", at + 1)) {
+    ++listed_frames;
+  }
+  EXPECT_EQ(listed_frames, 20U) << error;
+}
+
 }  // namespace
 }  // namespace keyplace
