@@ -39,7 +39,7 @@ void BindConfig(py::module_& module) {
       module, "Config",
       "The whole keyplace configuration: one section per module (input, "
       "features, odometry, mapping, place, slam, localization, evaluation, grid, "
-      "merge, node); `keyplace dump-config` lists every key with its unit and doc.")
+      "merge, node); `keyplace dump-config --all` lists every key with its unit and doc.")
       .def(py::init(&MakeConfig), py::arg("preset") = "default", py::arg("overrides") = py::none(),
            py::arg("file") = py::none(),
            "Config(preset='default', overrides=None, file=None): the preset ('default', 'paper' "

@@ -4,15 +4,18 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <ostream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/bounded_read.hpp"
 #include "io/yaml_document.hpp"
 #include "keyplace/config/config.hpp"
+#include "keyplace/config/essential_settings.hpp"
 
 namespace keyplace {
 namespace {
@@ -109,12 +112,12 @@ void ApplyNode(const YAML::Node& node, const std::string& prefix, const std::str
 
 }  // namespace
 
-std::string ConfigToYaml(const Config& config) {
-  std::ostringstream out;
-  out << "# keyplace configuration: every field with [unit] and meaning.\n"
-         "# Use with --config FILE.yaml; override one field with --set section.key=value.\n";
+namespace {
+
+// The fields as YAML, nested sections as nested mappings, each with its unit and doc.
+void WriteYamlFields(const std::vector<ConfigFieldInfo>& fields, std::ostream& out) {
   std::vector<std::string> open;  // path of the mapping being written
-  for (const ConfigFieldInfo& field : DescribeConfig(config)) {
+  for (const ConfigFieldInfo& field : fields) {
     std::vector<std::string> parts = SplitKey(field.key);
     const std::string name = parts.back();
     parts.pop_back();
@@ -131,6 +134,35 @@ std::string ConfigToYaml(const Config& config) {
     out << std::string(2 * parts.size(), ' ') << name << ": " << YamlScalar(field.value) << "  # "
         << Comment(field) << '\n';
   }
+}
+
+}  // namespace
+
+std::string ConfigToYaml(const Config& config) {
+  std::ostringstream out;
+  out << "# keyplace configuration: every field with [unit] and meaning.\n"
+         "# Use with --config FILE.yaml; override one field with --set section.key=value.\n";
+  WriteYamlFields(DescribeConfig(config), out);
+  return out.str();
+}
+
+std::string EssentialConfigToYaml(const Config& config) {
+  std::vector<ConfigFieldInfo> shown;
+  std::size_t left_out = 0;
+  for (ConfigFieldInfo& field : DescribeConfig(config)) {
+    if (IsEssentialConfigKey(field.key) || field.value != field.default_value) {
+      shown.push_back(std::move(field));
+    } else {
+      ++left_out;
+    }
+  }
+  std::ostringstream out;
+  out << "# keyplace configuration: the essential settings and those that differ from the\n"
+         "# defaults, each with [unit] and meaning. Use with --config FILE.yaml; override one\n"
+         "# field with --set section.key=value.\n";
+  WriteYamlFields(shown, out);
+  out << "\n# " << left_out
+      << " more settings at their defaults: keyplace dump-config --all shows every one.\n";
   return out.str();
 }
 

@@ -197,8 +197,20 @@ check "dump-config" "$keyplace" dump-config
 "$keyplace" dump-config >"$work/defaults.yaml"
 "$keyplace" dump-config --config "$work/defaults.yaml" >"$work/defaults-again.yaml"
 check "dump-config round trip" cmp "$work/defaults.yaml" "$work/defaults-again.yaml"
+"$keyplace" dump-config --all >"$work/all.yaml"
+"$keyplace" dump-config --all --config "$work/all.yaml" >"$work/all-again.yaml"
+check "dump-config --all round trip" cmp "$work/all.yaml" "$work/all-again.yaml"
+check "dump-config: the essential settings only" test \
+  "$(grep -c '  # ' "$work/defaults.yaml")" -lt "$(($(grep -c '  # ' "$work/all.yaml") / 5))"
+check "dump-config: says --all" grep -q "keyplace dump-config --all shows every one" \
+  "$work/defaults.yaml"
 "$keyplace" dump-config --preset paper >"$work/paper.yaml"
 check "paper preset differs" grep -q "^  selection: first_verified" "$work/paper.yaml"
+# The essential dump of a preset, read on the defaults, is that preset (its differences shown).
+"$keyplace" dump-config --all --config "$work/paper.yaml" >"$work/paper-from-file.yaml"
+"$keyplace" dump-config --all --preset paper >"$work/paper-all.yaml"
+check "dump-config --preset paper as a file is the paper preset" cmp "$work/paper-from-file.yaml" \
+  "$work/paper-all.yaml"
 # dump-config --json: the configuration the YAML shows, as the "config" object of other commands'
 # JSON, --set applied.
 check "dump-config --json" "$keyplace" dump-config --set place.ransac.iterations=40 \
@@ -211,14 +223,14 @@ assert j['place']['ransac']['iterations'] == '40', j['place']['ransac']
 defaults = yaml.load(open(sys.argv[2]), Loader=yaml.BaseLoader)
 defaults['place']['ransac']['iterations'] = '40'
 assert j == defaults, [k for k in j if j[k] != defaults.get(k)]
-" "$work/config.json" "$work/defaults.yaml"
+" "$work/config.json" "$work/all.yaml"
 fails_with "dump-config --json over its --config" "destroy the input" "$keyplace" dump-config \
   --config "$work/defaults.yaml" --json "$work/defaults.yaml"
 check "dump-config --set" sh -c "'$keyplace' dump-config --set place.ransac.iterations=40 | grep -q '^    iterations: 40 '"
 # (The first 300 scans: the identity holds or not whatever the length, in a fifth of the time.)
 check "map of 300 scans" "$keyplace" map "$log" --scans 0:300 --out "$work/map-300.kpm"
 check "map with the dumped defaults" "$keyplace" map "$log" --scans 0:300 \
-  --config "$work/defaults.yaml" --out "$work/map-config.kpm"
+  --config "$work/all.yaml" --out "$work/map-config.kpm"
 check "map byte-identical with --config defaults" cmp "$work/map-300.kpm" "$work/map-config.kpm"
 check "map json records the configuration" python3 -c "
 import json,sys

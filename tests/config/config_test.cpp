@@ -1,17 +1,23 @@
 #include "keyplace/config/config.hpp"
+#include "keyplace/config/essential_settings.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "config/spelling.hpp"
+#include "support/expect_contains.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
 namespace {
+
+using testing::ExpectContains;
 
 std::string ErrorOfYaml(const std::string& yaml) {
   Config config;
@@ -32,6 +38,47 @@ TEST(Config, DumpLoadDumpIsIdenticalForEveryPreset) {
     EXPECT_EQ(ConfigToYaml(loaded), yaml) << preset;
     EXPECT_EQ(ConfigKeyValues(loaded), ConfigKeyValues(original)) << preset;
   }
+}
+
+// dump-config without --all: the essential settings and the changed ones, still a file that gives
+// the configuration back on the defaults (a preset's differences included).
+TEST(Config, TheEssentialDumpGivesTheConfigurationBackForEveryPreset) {
+  for (const std::string& preset : ConfigPresetNames()) {
+    Config original = PresetConfig(preset);
+    original.place.ransac.iterations = 40;  // not essential, changed: must be in the dump
+    const std::string yaml = EssentialConfigToYaml(original);
+    Config loaded;
+    ApplyConfigYaml(yaml, "dump", loaded);
+    EXPECT_EQ(ConfigKeyValues(loaded), ConfigKeyValues(original)) << preset;
+    EXPECT_NE(yaml.find("    iterations: 40  # "), std::string::npos) << preset;
+  }
+}
+
+TEST(Config, TheEssentialDumpOfTheDefaultsHoldsTheEssentialKeysOnly) {
+  const std::vector<std::string>& essential = EssentialConfigKeys();
+  EXPECT_GE(essential.size(), 10U);
+  EXPECT_LE(essential.size(), 20U);
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : ConfigKeyValues(Config{})) keys.push_back(key);
+  std::size_t last_position = 0;
+  for (const std::string& key : essential) {
+    const auto at = std::find(keys.begin(), keys.end(), key);
+    ASSERT_NE(at, keys.end()) << key << " is no configuration key";
+    const auto position = static_cast<std::size_t>(at - keys.begin());
+    EXPECT_GE(position, last_position) << key << ": not in the field table's order";
+    last_position = position;
+  }
+  const std::string yaml = EssentialConfigToYaml(Config{});
+  std::size_t fields = 0;  // lines "key: value  # doc"
+  for (std::size_t at = yaml.find("  # "); at != std::string::npos;
+       at = yaml.find("  # ", at + 1)) {
+    ++fields;
+  }
+  EXPECT_EQ(fields, essential.size()) << yaml;
+  EXPECT_NE(yaml.find("  min_stability: 0.3  # "), std::string::npos);
+  EXPECT_EQ(yaml.find("iterations:"), std::string::npos);
+  ExpectContains(yaml, std::to_string(keys.size() - essential.size()) +
+                           " more settings at their defaults: keyplace dump-config --all");
 }
 
 TEST(Config, ChangedValuesSurviveTheRoundTripExactly) {
