@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/map_localization.hpp"
 #include "keyplace/eval/slam_evaluation.hpp"
@@ -23,10 +24,7 @@ namespace {
 // How the evaluated log is read: the config's input, features and odometry sections, a pose
 // source and a scan range (first, end) as `--scans`.
 LogInputOptions InputOptions(const Config& config, const py::object& scans) {
-  LogInputOptions options;
-  options.reading.bag = config.input;
-  options.odometry = config.odometry;
-  options.features = config.features;
+  LogInputOptions options = LogInputOptionsFor(config);
   ApplyScans(scans, options);
   return options;
 }

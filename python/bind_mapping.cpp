@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
@@ -28,12 +29,9 @@ GlobalMap BuildMap(const std::string& path, const py::object& config, const py::
                    const py::object& poses, const py::object& scans, bool start_at_origin,
                    bool skip_bad_lines) {
   const Config resolved = ResolveConfig(config, overrides).config;
-  LogInputOptions options;
-  options.reading.bag = resolved.input;
+  LogInputOptions options = LogInputOptionsFor(resolved);
   options.reading.skip_bad_lines = skip_bad_lines;
   if (!poses.is_none()) options.poses = ParsePoseSource(poses.cast<std::string>());
-  options.odometry = resolved.odometry;
-  options.features = resolved.features;
   options.start_at_origin = start_at_origin;
   ApplyScans(scans, options);
   py::gil_scoped_release release;

@@ -13,6 +13,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/eval/slam_evaluation.hpp"
 #include "keyplace/localization/initial_pose.hpp"
 #include "keyplace/mapping/map_server.hpp"
@@ -58,11 +59,9 @@ PyGrid BuildGrid(const std::string& path, const py::object& config, const py::ob
   if (run != nullptr && !poses.is_none()) {
     throw py::value_error("build_grid: give poses or slam_run, not both");
   }
-  LogInputOptions options;
-  options.reading.bag = resolved.input;
+  LogInputOptions options = LogInputOptionsFor(resolved);
   options.reading.skip_bad_lines = skip_bad_lines;
   if (!poses.is_none()) options.poses = ParsePoseSource(poses.cast<std::string>());
-  options.odometry = resolved.odometry;
   options.start_at_origin = start_at_origin;
   options.keypoints = false;               // a grid needs scans and poses only
   options.compute_poses = run == nullptr;  // a SLAM run brings its own

@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
@@ -47,12 +48,9 @@ PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
   if (self_match != "shared-scan" && self_match != "none") {
     throw py::value_error("self_match is '" + self_match + "': 'shared-scan' or 'none'");
   }
-  LogInputOptions input_options;
-  input_options.reading.bag = resolved.input;
+  LogInputOptions input_options = LogInputOptionsFor(resolved);
   input_options.reading.skip_bad_lines = skip_bad_lines;
   input_options.poses = ParsePoseSource(poses);
-  input_options.odometry = resolved.odometry;
-  input_options.features = resolved.features;
   ApplyScans(scans, input_options);
   const std::string truth_path = TextOrEmpty(truth);
   const std::string index_path = TextOrEmpty(index);

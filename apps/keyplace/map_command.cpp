@@ -12,6 +12,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
@@ -165,12 +166,10 @@ void RunMap(const CLI::App& command, const MapOptions& options) {
       c.mapping.min_stable_keypoints = 0;
     }
   });
-  LogInputOptions input_options;
-  input_options.reading = ReadingOptions(config, options.skip_bad_lines);
+  LogInputOptions input_options = LogInputOptionsFor(config);
+  input_options.reading.skip_bad_lines = options.skip_bad_lines;
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
-  input_options.odometry = config.odometry;
   input_options.start_at_origin = options.start_at_origin;
-  input_options.features = config.features;
   input_options.cache_dir = options.cache_dir;
   ApplyScanRange(options.scans, input_options);
   const LogInputs inputs = PrepareLogInputs(options.input, input_options, StageProgressBar());

@@ -2,6 +2,7 @@
 
 #include "cli_support.hpp"
 #include "config_options.hpp"
+#include "keyplace/config/log_inputs.hpp"
 
 namespace keyplace::cli {
 
@@ -37,10 +38,9 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
 
 QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {
   QueryLog query;
-  query.input_options.reading = ReadingOptions(config, options.skip_bad_lines);
+  query.input_options = LogInputOptionsFor(config);
+  query.input_options.reading.skip_bad_lines = options.skip_bad_lines;
   query.input_options.poses = ParsePoseSource(options.poses);
-  query.input_options.odometry = config.odometry;
-  query.input_options.features = config.features;
   query.input_options.cache_dir = options.cache_dir;
   ApplyScanRange(options.scans, query.input_options);
   query.inputs = PrepareLogInputs(options.log_path, query.input_options, StageProgressBar());

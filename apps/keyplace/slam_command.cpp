@@ -15,6 +15,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/slam_evaluation.hpp"
 #include "keyplace/io/relations.hpp"
@@ -45,10 +46,8 @@ struct SlamOptions {
 
 // The log's scans and keypoints; SLAM estimates the poses itself.
 LogInputs PrepareInputs(const std::string& path, const Config& config) {
-  LogInputOptions options;
+  LogInputOptions options = LogInputOptionsFor(config);
   options.compute_poses = false;
-  options.reading = ReadingOptions(config);
-  options.features = config.features;
   return PrepareLogInputs(path, options, StageProgressBar());
 }
 

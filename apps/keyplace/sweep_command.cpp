@@ -16,6 +16,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "config_options.hpp"
+#include "keyplace/config/log_inputs.hpp"
 #include "keyplace/eval/global_localization.hpp"
 #include "sweep_grid.hpp"
 #include "sweep_points.hpp"
@@ -45,11 +46,8 @@ struct SweepOptions {
 
 // The expensive inputs shared by every grid point: the log (cut to --scans), poses, keypoints.
 LogInputs PrepareInputs(const SweepOptions& options, const Config& config, bool need_corrected) {
-  LogInputOptions input_options;
-  input_options.reading = ReadingOptions(config);
+  LogInputOptions input_options = LogInputOptionsFor(config);
   if (!options.poses.empty()) input_options.poses = ParsePoseSource(options.poses);
-  input_options.odometry = config.odometry;
-  input_options.features = config.features;
   ApplyScanRange(options.scans, input_options);
   LogInputs inputs = PrepareLogInputs(options.log_path, input_options, StageProgressBar());
   if (inputs.log.scans.size() < 2) {
