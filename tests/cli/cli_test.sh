@@ -23,7 +23,8 @@ check "info beams" test "$(json_value "$work/info.json" beams_per_scan_max)" = 3
 # FLASER lines state no angles: info says how their beams were spread (odd counts first to last).
 python3 -c "print('FLASER 181 ' + ' '.join(['2.0'] * 181) + ' 0 0 0 0 0 0 1 h 1')" >"$work/odd.log"
 check "info on 181 FLASER beams" "$keyplace" info "$work/odd.log" --json "$work/odd.json"
-check "info names the odd-count spacing" grep -q "beam spacing    step fov/(n-1), first and last beam" "$work/out"
+cp "$work/out" "$work/odd.txt"  # check writes its own command's output to $work/out
+check "info names the odd-count spacing" grep -q "beam spacing    step fov/(n-1), first and last beam" "$work/odd.txt"
 check "info json spacing rule" python3 -c "
 import json,sys; s=json.load(open(sys.argv[1]))['flaser_beam_spacing']
 assert s == {'rule': 'fov/(n-1)', 'scans_fov_over_n': 0, 'scans_fov_over_n_minus_1': 1}, s" "$work/odd.json"
