@@ -9,6 +9,7 @@ PYBIND11_MODULE(keyplace, module) {
       "stable keypoints, global localization, SLAM). Poses are numpy arrays [x_m, y_m, theta_rad]; "
       "errors of the library raise ValueError (bad input or configuration) or RuntimeError (files "
       "that cannot be read or written) with the library's message. See docs/PYTHON.md.";
+  module.attr("__version__") = KEYPLACE_VERSION;
   keyplace::python::BindConfig(module);
   keyplace::python::BindIo(module);
   keyplace::python::BindFeatures(module);

@@ -34,7 +34,7 @@ int Run(int argc, char** argv) {
       "Logs are CARMEN text files, plain or .gz, ROS 1 bags or ROS 2 bags (rosbag2 directory, "
       ".mcap or .db3; --scan-topic, --odom-topic, "
       "--laser-pose; docs/ROS.md)."};
-  app.set_version_flag("--version", "keyplace 0.1.0");
+  app.set_version_flag("--version", std::string("keyplace ") + KEYPLACE_VERSION);
   app.require_subcommand(1);
   keyplace::cli::RegisterInfoCommand(app);
   keyplace::cli::RegisterFeaturesCommand(app);

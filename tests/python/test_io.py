@@ -3,6 +3,7 @@
 import json
 import math
 import os
+import re
 import tempfile
 import threading
 import unittest
@@ -10,7 +11,15 @@ import unittest
 import numpy as np
 
 import keyplace
-from support import BUNDLED_LOG, robotlaser_lines, run_cli
+from support import BUNDLED_LOG, SOURCE_DIR, robotlaser_lines, run_cli
+
+
+class VersionTest(unittest.TestCase):
+    def test_the_module_has_the_projects_version_as_the_command(self):
+        with open(os.path.join(SOURCE_DIR, "CMakeLists.txt")) as cmake:
+            project = re.search(r"project\(keyplace VERSION ([0-9.]+)", cmake.read()).group(1)
+        self.assertEqual(keyplace.__version__, project)
+        self.assertEqual(run_cli("--version").strip(), "keyplace " + project)
 
 
 class ReadLogTest(unittest.TestCase):
