@@ -36,17 +36,21 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options,
       ->capture_default_str();
 }
 
-QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config) {
+QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config, bool truth_optional) {
   QueryLog query;
   query.input_options = LogInputOptionsFor(config);
   query.input_options.reading.skip_bad_lines = options.skip_bad_lines;
-  query.input_options.poses = ParsePoseSource(options.poses);
+  if (!options.poses.empty()) query.input_options.poses = ParsePoseSource(options.poses);
   query.input_options.cache_dir = options.cache_dir;
   ApplyScanRange(options.scans, query.input_options);
   query.inputs = PrepareLogInputs(options.log_path, query.input_options, StageProgressBar());
   PrintInputsWarnings(query.inputs);
+  const bool truth_available = !options.truth_path.empty() || query.inputs.log.corrected;
+  if (!truth_available && truth_optional) return query;  // has_truth stays false
+  // Without truth this throws, asking for --truth and --index.
   query.truth = LoadGroundTruth(query.inputs.log, query.inputs.first_scan, query.inputs.file_scans,
                                 options.truth_path, options.index_path, query.inputs.source_hash);
+  query.has_truth = true;
   return query;
 }
 

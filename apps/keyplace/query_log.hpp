@@ -30,11 +30,15 @@ void AddQueryLogOptions(CLI::App* command, QueryLogOptions& options, const std::
 struct QueryLog {
   LogInputOptions input_options;  // as the log was read (for more logs read alike)
   LogInputs inputs;
-  GroundTruth truth;
+  bool has_truth = false;  // false: no --truth and the log has no corrected poses
+  GroundTruth truth;       // when has_truth
 };
 
 /// Reads the log (poses, keypoints, the --scans cut) with progress, prints its warnings and loads
-/// its ground truth (its own corrected poses, or --truth through --index).
-QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config);
+/// its ground truth (its own corrected poses, or --truth through --index). An empty
+/// options.poses takes the log's corrected poses if it has them, else ICP. Without truth the
+/// error asks for --truth, unless `truth_optional` (then has_truth is false).
+QueryLog ReadQueryLog(const QueryLogOptions& options, const Config& config,
+                      bool truth_optional = false);
 
 }  // namespace keyplace::cli

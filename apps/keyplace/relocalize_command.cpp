@@ -1,10 +1,12 @@
 // keyplace relocalize: the kidnapped-robot benchmark (eval/relocalization.hpp). From --starts
 // starts spread over the query log a Relocalizer that knows nothing is fed scans and odometry
-// until it declares a fix or gives up; every fix it reports is checked against the truth.
+// until it declares a fix or gives up; every fix it reports is checked against the truth. A log
+// without truth is relocalized once, as a robot would be (localization/log_relocalization.hpp).
 
 #include <chrono>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,9 +18,11 @@
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/localization/initial_pose.hpp"
+#include "keyplace/localization/log_relocalization.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "localize_output.hpp"
 #include "query_log.hpp"
+#include "relocalize_log_output.hpp"
 #include "relocalize_output.hpp"
 
 namespace keyplace::cli {
@@ -50,6 +54,43 @@ void WriteFirstFix(const std::string& path, const RelocalizeReport& report) {
              first->start_scan, first->fix.scan, path);
 }
 
+// No truth (no --truth, no corrected poses in the log): the log relocalized once from its first
+// scan, what the Relocalizer said at each scan.
+void RunWithoutTruth(const CLI::App& command, const RelocalizeOptions& options,
+                     const Config& config, const GlobalMap& map, const LogInputs& inputs) {
+  for (const char* option : {"--tsv", "--figure"}) {
+    if (command.count(option) > 0) {
+      throw std::invalid_argument(std::string(option) + " needs the truth (the benchmark's " +
+                                  "starts): give --truth and --index, or a corrected log");
+    }
+  }
+  if (command.count("--starts") > 0) {
+    fmt::print(stderr,
+               "keyplace: note: --starts is the benchmark's; without truth the log is "
+               "relocalized once, from its first scan\n");
+  }
+  Progress progress("scans", inputs.log.scans.size());
+  const LogRelocalization run =
+      RelocalizeLog(map, inputs, ToLocalizerConfig(config),
+                    [&](std::size_t done, std::size_t) { progress.Update(done); });
+  progress.Finish();
+  PrintLogRelocalization(run, inputs, options.map_path, map, options.query.log_path);
+  if (!options.fixes_path.empty()) WriteScanStatusTsv(options.fixes_path, run);
+  if (!options.initial_pose_path.empty()) {
+    if (run.first_fix_pose) {
+      WriteInitialPose(*run.first_fix_pose, options.initial_pose_path);
+    } else {
+      fmt::print(stderr, "keyplace: note: no fix; {} not written\n", options.initial_pose_path);
+    }
+  }
+  if (!options.json_path.empty()) {
+    nlohmann::json json =
+        LogRelocalizationJson(run, inputs, options.map_path, options.query.log_path);
+    json["config"] = ConfigJson(config);
+    WriteJson(options.json_path, json);
+  }
+}
+
 void RunRelocalize(const CLI::App& command, const RelocalizeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CheckOutputs(command, {{"--json", options.json_path},
@@ -61,8 +102,16 @@ void RunRelocalize(const CLI::App& command, const RelocalizeOptions& options) {
   const Config config = ResolveConfig(options.config);
   const GlobalMap map = LoadMap(options.map_path);
 
-  const QueryLog query = ReadQueryLog(options.query, config);
+  QueryLogOptions query_options = options.query;
+  // Without --truth or --poses: the log's corrected poses when it has them (the benchmark), else
+  // ICP on its odometry (a robot's run).
+  if (command.count("--poses") == 0 && query_options.truth_path.empty()) query_options.poses = "";
+  const QueryLog query = ReadQueryLog(query_options, config, /*truth_optional=*/true);
   const LogInputs& inputs = query.inputs;
+  if (!query.has_truth) {
+    RunWithoutTruth(command, options, config, map, inputs);
+    return;
+  }
   const GroundTruth& truth = query.truth;
 
   RelocalizeReport report;
@@ -117,14 +166,18 @@ void RegisterRelocalizeCommand(CLI::App& app) {
       "The kidnapped-robot benchmark: from --starts starts spread over the query log the "
       "localizer, knowing nothing, is fed scans and odometry until two answers agree on a fix "
       "(or it gives up after evaluation.give_up_m of travel); it then runs evaluation.follow_m "
-      "further and every fix it reports is checked against the truth (0.5 m, 10 deg). Uses the "
-      "strict preset unless --preset says otherwise.");
+      "further and every fix it reports is checked against the truth (0.5 m, 10 deg). Without "
+      "truth (no --truth, a log or bag without corrected poses) the log is relocalized once from "
+      "its first scan as a robot would be: the status and pose at every scan (--fixes), the "
+      "first fix (--initialpose), a summary (--json). Uses the strict preset unless --preset "
+      "says otherwise.");
   command->add_option("--map", options->map_path, "Map file (.kpm)")
       ->required()
       ->check(CLI::ExistingFile);
   AddQueryLogOptions(command, options->query,
                      "Odometry fed to the localizer: corrected (the log's), icp (scan matching "
-                     "on odometry) or odometry");
+                     "on odometry) or odometry; without --truth and --poses: corrected when the "
+                     "log has them, else icp");
   command->add_option("--starts", options->starts, "Number of starts")->capture_default_str();
   command
       ->add_option("--self-match", options->self_match,
@@ -141,7 +194,8 @@ void RegisterRelocalizeCommand(CLI::App& app) {
   command->add_option("--tsv", options->tsv_path, "Write one TSV row per start to FILE");
   command->add_option("--fixes", options->fixes_path,
                       "Write one TSV row per fix reported (pose, truth, error, and the covariance "
-                      "over x, y, theta derived from the matches) to FILE");
+                      "over x, y, theta derived from the matches) to FILE; without truth one row "
+                      "per scan (status, pose when fixed, confidence)");
   command->add_option("--figure", options->figure_path,
                       "Draw the starts, paths and fixes (.png or .svg)");
   command->add_option("--initialpose", options->initial_pose_path,

@@ -130,4 +130,29 @@ fails_with "bad map" "not.kpm" "$keyplace" relocalize --map "$work/not.kpm" --lo
   --json "$work/keep.json"
 check "existing JSON kept" grep -q kept "$work/keep.json"
 
+# Without truth (a raw log of the same building, no --truth): relocalized once from its first
+# scan as a robot would be, ICP on its odometry; a row per scan, the first fix, a JSON summary.
+raw="$source_dir/tests/data/ros2/fr079-raw-first150.log.gz"
+check "relocalize without truth" "$keyplace" relocalize --map "$work/map.kpm" --log "$raw" \
+  --fixes "$work/raw-fixes.tsv" --initialpose "$work/raw-fix.yaml" --json "$work/raw.json"
+cp "$work/out" "$work/raw.txt"  # check writes its own command's output to $work/out
+check "without truth: says so" grep -q "^protocol     no truth" "$work/raw.txt"
+check "without truth: a row per scan, the first fix in the JSON" /usr/bin/python3 -c "
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1]), delimiter='\t'))
+summary = json.load(open(sys.argv[2]))
+assert len(rows) == 150 == summary['scans'], (len(rows), summary['scans'])
+assert summary['truth'] is False and summary['pose_source'] == 'icp', summary
+first = summary['first_fix']
+assert first is not None, summary
+fixed = [r for r in rows if r['status'] == 'fixed']
+assert fixed and int(fixed[0]['scan']) == first['scan'] and fixed[0]['new_fix'] == '1', fixed[:1]
+assert abs(float(fixed[0]['x_m']) - first['x_m']) < 1e-3, (fixed[0], first)
+assert all(r['x_m'] == '' for r in rows if r['status'] != 'fixed')
+assert sum(r['answered'] == '1' for r in rows) == summary['answers']
+" "$work/raw-fixes.tsv" "$work/raw.json"
+check "without truth: the first fix as /initialpose" grep -q "frame_id: map" "$work/raw-fix.yaml"
+fails_with "without truth: --tsv asks for truth" "--tsv needs the truth" "$keyplace" relocalize \
+  --map "$work/map.kpm" --log "$raw" --tsv "$work/raw.tsv"
+
 finish relocalize
