@@ -1,8 +1,11 @@
 #include "io/yaml_document.hpp"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -45,12 +48,61 @@ void CheckKeys(const YAML::Node& node, const std::string& source, std::size_t& v
   }
 }
 
+// Where a document's content starts (its first node), the only thing the document count needs.
+// yaml-cpp's LoadAll loops without end on some malformed input (" ,a,[ ,\xe8cel": every call of
+// the parser returns one more empty document at the same place, until memory runs out; found by
+// the config_yaml fuzzer), so documents are counted here, two at most, and a document that
+// starts where the previous one did is malformed input.
+class DocumentStart : public YAML::EventHandler {
+ public:
+  const YAML::Mark& mark() const { return mark_; }
+  void OnDocumentStart(const YAML::Mark& mark) override { Content(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t /*anchor*/) override { Content(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t /*anchor*/) override { Content(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string& /*tag*/, YAML::anchor_t /*anchor*/,
+                const std::string& /*value*/) override {
+    Content(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string& /*tag*/,
+                       YAML::anchor_t /*anchor*/, YAML::EmitterStyle::value /*style*/) override {
+    Content(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string& /*tag*/, YAML::anchor_t /*anchor*/,
+                  YAML::EmitterStyle::value /*style*/) override {
+    Content(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  // The document start's mark until the first node's replaces it.
+  void Content(const YAML::Mark& mark) {
+    if (events_++ < 2) mark_ = mark;
+  }
+  YAML::Mark mark_;
+  int events_ = 0;
+};
+
 }  // namespace
 
 YAML::Node LoadYamlDocument(const std::string& text, const std::string& source) {
-  std::vector<YAML::Node> documents;
+  YAML::Node document;
   try {
-    documents = YAML::LoadAll(text);
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStart first;
+    if (!parser.HandleNextDocument(first)) return YAML::Node();  // nothing but comments
+    DocumentStart second;
+    if (parser.HandleNextDocument(second)) {
+      if (second.mark().pos <= first.mark().pos) {
+        throw std::invalid_argument(Where(source, second.mark()) +
+                                    "malformed YAML: the parser makes no progress from here");
+      }
+      throw std::invalid_argument(Where(source, second.mark()) +
+                                  "a second YAML document (after '---'); the file must hold one");
+    }
+    document = YAML::Load(text);
   } catch (const YAML::DeepRecursion& error) {
     throw std::invalid_argument(Where(source, error.mark) +
                                 "YAML nested too deeply (yaml-cpp stops at " +
@@ -58,14 +110,9 @@ YAML::Node LoadYamlDocument(const std::string& text, const std::string& source) 
   } catch (const YAML::Exception& error) {
     throw std::invalid_argument(Where(source, error.mark) + "malformed YAML: " + error.msg);
   }
-  if (documents.empty()) return YAML::Node();
-  if (documents.size() > 1) {
-    throw std::invalid_argument(Where(source, documents[1].Mark()) +
-                                "a second YAML document (after '---'); the file must hold one");
-  }
   std::size_t visited = 0;
-  CheckKeys(documents[0], source, visited, 0);
-  return documents[0];
+  CheckKeys(document, source, visited, 0);
+  return document;
 }
 
 }  // namespace keyplace
