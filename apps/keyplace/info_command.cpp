@@ -60,9 +60,8 @@ nlohmann::json FlaserSpacingJson(const CarmenLog& log) {
 std::string FlaserSpacingText(const nlohmann::json& spacing) {
   const auto over_n = spacing["scans_fov_over_n"].get<std::size_t>();
   const auto over_n_minus_one = spacing["scans_fov_over_n_minus_1"].get<std::size_t>();
-  const std::string even = "step fov/n from -fov/2 (even beam count, FLIRTLib's convention)";
-  const std::string odd =
-      "step fov/(n-1), first and last beam at -fov/2 and +fov/2 (odd beam count)";
+  const char* even = "step fov/n from -fov/2 (even beam count, FLIRTLib's convention)";
+  const char* odd = "step fov/(n-1), first and last beam at -fov/2 and +fov/2 (odd beam count)";
   if (over_n_minus_one == 0) return even;
   if (over_n == 0) return odd;
   return fmt::format("{} FLASER scans {}; {} {}", over_n, even, over_n_minus_one, odd);
