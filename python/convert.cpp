@@ -1,6 +1,7 @@
 // Conversions between the library's types and numpy arrays, and configuration from Python.
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -184,10 +185,45 @@ py::array_t<double> PosesArray(const std::vector<Pose2>& poses) {
   return array;
 }
 
+namespace {
+
+// A 3 x 3 homogeneous transform [[c, -s, x], [s, c, y], [0, 0, 1]] as a pose; anything that is not
+// a rigid motion of the plane (within rounding) is refused, naming what is wrong.
+Pose2 PoseOfMatrix(const py::array_t<double, py::array::c_style | py::array::forcecast>& m,
+                   const std::string& what) {
+  constexpr double kTolerance = 1e-6;
+  const auto at = [&](py::ssize_t row, py::ssize_t column) { return m.at(row, column); };
+  for (py::ssize_t row = 0; row < 3; ++row) {
+    for (py::ssize_t column = 0; column < 3; ++column) {
+      if (!std::isfinite(at(row, column))) {
+        throw py::value_error(what + ": the 3 x 3 matrix has a value that is not finite");
+      }
+    }
+  }
+  if (std::abs(at(2, 0)) > kTolerance || std::abs(at(2, 1)) > kTolerance ||
+      std::abs(at(2, 2) - 1.0) > kTolerance) {
+    throw py::value_error(what + ": the last row of a 3 x 3 homogeneous transform is [0, 0, 1]");
+  }
+  const double c = at(0, 0), s = at(1, 0);
+  if (std::abs(at(1, 1) - c) > kTolerance || std::abs(at(0, 1) + s) > kTolerance ||
+      std::abs(c * c + s * s - 1.0) > kTolerance) {
+    throw py::value_error(what +
+                          ": the upper left 2 x 2 block is not a rotation [[c, -s], [s, c]]");
+  }
+  return {at(0, 2), at(1, 2), std::atan2(s, c)};
+}
+
+}  // namespace
+
 Pose2 ToPose(const py::handle& value, const std::string& what) {
   const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (array && array.ndim() == 2 && array.shape(0) == 3 && array.shape(1) == 3) {
+    return PoseOfMatrix(array, what);
+  }
   if (!array || array.ndim() != 1 || array.size() != 3) {
-    throw py::value_error(what + " must be three numbers [x_m, y_m, theta_rad]");
+    throw py::value_error(what +
+                          " must be three numbers [x_m, y_m, theta_rad] or a 3 x 3 homogeneous "
+                          "transform");
   }
   return {array.at(0), array.at(1), array.at(2)};
 }

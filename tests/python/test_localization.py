@@ -90,6 +90,36 @@ class LocalizationTest(unittest.TestCase):
                 break
         self.assertEqual(relocalizer.status, "fixed")
 
+    def test_poses_as_3x3_homogeneous_matrices_give_the_same_answers(self):
+        def matrix(pose):
+            c, s = math.cos(pose[2]), math.sin(pose[2])
+            return np.array([[c, -s, pose[0]], [s, c, pose[1]], [0.0, 0.0, 1.0]])
+
+        by_vector = keyplace.Relocalizer(self.map_path)
+        by_matrix = keyplace.Relocalizer(self.map_path)
+        fixed = 0
+        for scan in self.log.scans:
+            a = by_vector.add_scan(scan, scan.corrected_pose)
+            b = by_matrix.add_scan(scan, matrix(scan.corrected_pose))
+            self.assertEqual(a.status, b.status)
+            if a.status == "fixed":
+                fixed += 1
+                np.testing.assert_allclose(a.pose, b.pose, atol=1e-9)
+                if fixed == 20:
+                    break
+        self.assertEqual(fixed, 20)
+        scan = self.log.scans[0]
+        bad_row = matrix(scan.corrected_pose)
+        bad_row[2, 0] = 0.5
+        with self.assertRaisesRegex(ValueError, r"odom_pose: the last row .* \[0, 0, 1\]"):
+            by_matrix.add_scan(scan, bad_row)
+        scaled = matrix(scan.corrected_pose)
+        scaled[:2, :2] *= 2.0
+        with self.assertRaisesRegex(ValueError, "odom_pose: the upper left 2 x 2 block is not"):
+            by_matrix.add_scan(scan, scaled)
+        with self.assertRaisesRegex(ValueError, "or a 3 x 3 homogeneous transform"):
+            by_matrix.add_scan(scan, np.eye(4))
+
     def test_localize_equals_the_cli(self):
         figures = os.path.join(self.work.name, "localize.json")
         queries = os.path.join(self.work.name, "queries.tsv")
