@@ -41,6 +41,15 @@ echo "   in the second half; the Relocalizer fixes when two answers agree (keypl
 "$keyplace" relocalize --map "$out/map-first-half.kpm" --log "$log" --scans 732: --starts 12 \
   --json "$out/relocalize.json" --figure "$out/relocalize.png" | sed -n '3,11p'
 echo
+echo "== A robot's own log, no truth: the first 150 raw scans of the same run with their wheel"
+echo "   odometry (the first 37 corrected scans), relocalized as a robot would be on the map of"
+echo "   the log's second half, which the robot reaches again; the first fix becomes /initialpose"
+raw="$(dirname "$0")/../tests/data/ros2/fr079-raw-first150.log.gz"
+"$keyplace" map "$log" --scans 732: --out "$out/map-second-half.kpm" >/dev/null
+"$keyplace" relocalize --map "$out/map-second-half.kpm" --log "$raw" \
+  --fixes "$out/robot-fixes.tsv" --initialpose "$out/robot-initialpose.yaml" | sed -n '3,6p'
+echo
 echo "Outputs in $out: info.json, features.json, keypoints.tsv, map-table2.json, map.kpm, map.png,"
 echo "map.json, localize.json, localize-queries.tsv, localize-curve.tsv, localize-stream.txt,"
-echo "map-first-half.kpm, relocalize.json, relocalize.png"
+echo "map-first-half.kpm, relocalize.json, relocalize.png, map-second-half.kpm, robot-fixes.tsv,"
+echo "robot-initialpose.yaml"
