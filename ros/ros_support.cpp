@@ -59,31 +59,24 @@ Config ConfigFromParameters(const ros::NodeHandle& private_node,
                             const std::string& default_preset) {
   std::string preset = default_preset;
   private_node.getParam("preset", preset);
-  Config config = PresetConfig(preset);
+  // As the command line: preset, file, single keys, then ~set, validated once after the last, so
+  // settings valid only together may come from any of them.
+  ConfigBuilder builder(PresetConfig(preset));
   std::string config_file;
   if (private_node.getParam("config_file", config_file) && !config_file.empty()) {
-    ApplyConfigFile(config_file, config);
+    builder.File(config_file);
   }
-  for (const auto& [key, unused] : ConfigKeyValues(config)) {
+  for (const auto& [key, unused] : ConfigKeyValues(Config{})) {
     std::string name = key;
     for (char& c : name) c = c == '.' ? '/' : c;
     XmlRpc::XmlRpcValue value;
     if (!private_node.getParam(name, value)) continue;
-    try {
-      SetConfigValue(key, ParameterText(value, name), config);
-    } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument("parameter ~" + name + ": " + error.what());
-    }
+    builder.Set(key, ParameterText(value, name), "parameter ~" + name);
   }
   for (const std::string& assignment : Assignments(private_node)) {
-    try {
-      ApplyConfigAssignment(assignment, config);
-    } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument("parameter ~set: " + std::string(error.what()));
-    }
+    builder.Assign(assignment, "parameter ~set");
   }
-  Validate(config);
-  return config;
+  return builder.Build();
 }
 
 std::string RequiredParameter(const ros::NodeHandle& private_node, const std::string& name) {
