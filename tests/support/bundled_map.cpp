@@ -8,7 +8,12 @@ namespace keyplace::testing {
 const BundledMap& BundledFr079() {
   static const BundledMap bundled = [] {
     BundledMap b;
-    b.inputs = PrepareLogInputs(SourceDir() + "/data/fr079-corrected.log.gz");
+    // ctest runs every test case in its own process, and FLIRT on the 1464 scans takes seconds
+    // (half a minute under the sanitizers): the preparation cache keeps the keypoints between
+    // processes, the same bit for bit, keyed by the code that computes them.
+    LogInputOptions options;
+    options.cache_dir = KEYPLACE_TEST_CACHE_DIR;
+    b.inputs = PrepareLogInputs(SourceDir() + "/data/fr079-corrected.log.gz", options);
     b.map =
         BuildGlobalMap({b.inputs.log.scans, b.inputs.poses, b.inputs.keypoints}, MappingConfig{});
     b.truth = TruthFromOwnPoses(b.inputs.log);
