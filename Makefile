@@ -19,11 +19,24 @@ FUZZ_SEED ?= 1
 SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return_null=1:check_initialization_order=1 \
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0
-# Not run under the sanitizers, for time only: the two whole-log oracle comparisons (110 s of the
-# ordinary suite's ~400 s, about 10 CPU minutes sanitized) and the whole-log bag map (50 s). The
-# code they cover runs sanitized in the smaller tests of the same classes (GlobalLocalizer.*,
-# DescriptorIndex.*, PlaceDatabase.*, Ros1Bag*).
-SANITIZE_SKIP := ^(GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog|DescriptorIndex.SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog|BagMap.Fr079BagGivesTheMapOfTheLogRebuiltFromIt)$$
+# Not run under the sanitizers, for time only (docs/RELIABILITY.md, Sanitizers): the whole-log
+# comparisons of one answer against another way of computing it (oracles, thread counts,
+# thresholds, the place database, all-scan loop queries; 90-310 s each sanitized), the whole-log
+# bag map, and three command-line scripts that check the front end's own behaviour (argument and
+# output-path refusals, merge and report end to end; 50-135 s each). The library code they run
+# runs sanitized in the smaller tests of the same classes and in the other scripts.
+SANITIZE_SKIP_TESTS := GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog \
+  DescriptorIndex.SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog \
+  BagMap.Fr079BagGivesTheMapOfTheLogRebuiltFromIt \
+  OnlineSlam.LoopQueriesUseTheKeypointsOfAllScans \
+  OnlineSlam.AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld \
+  ParallelRecognition.SameAnswerAtOneTwoAndFourThreadsOnTheBundledLog \
+  RecognitionThresholds.EachAnswerIsThatOfARecognizerWithThoseThresholds \
+  PlaceDatabase.AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog \
+  cli.clash cli.merge cli.report
+empty :=
+space := $(empty) $(empty)
+SANITIZE_SKIP := ^($(subst $(space),|,$(strip $(SANITIZE_SKIP_TESTS))))$$
 
 .PHONY: all deps configure build build-demo demo test test-fast test-slow build-sanitize \
   test-sanitize fuzz bench report format format-check tidy tidy-ci install clean
