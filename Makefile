@@ -21,10 +21,9 @@ SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0
 # Not run under the sanitizers, for time only (docs/RELIABILITY.md, Sanitizers): the whole-log
 # comparisons of one answer against another way of computing it (oracles, thread counts,
-# thresholds, the place database, all-scan loop queries; 90-310 s each sanitized), the whole-log
-# bag map, and three command-line scripts that check the front end's own behaviour (argument and
-# output-path refusals, merge and report end to end; 50-135 s each). The library code they run
-# runs sanitized in the smaller tests of the same classes and in the other scripts.
+# thresholds, the place database, all-scan loop queries; 90-310 s each sanitized) and the
+# whole-log bag map. The library code they run runs sanitized in the smaller tests of the same
+# classes.
 SANITIZE_SKIP_TESTS := GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog \
   DescriptorIndex.SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog \
   BagMap.Fr079BagGivesTheMapOfTheLogRebuiltFromIt \
@@ -32,8 +31,7 @@ SANITIZE_SKIP_TESTS := GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryO
   OnlineSlam.AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld \
   ParallelRecognition.SameAnswerAtOneTwoAndFourThreadsOnTheBundledLog \
   RecognitionThresholds.EachAnswerIsThatOfARecognizerWithThoseThresholds \
-  PlaceDatabase.AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog \
-  cli.clash cli.merge cli.report
+  PlaceDatabase.AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog
 empty :=
 space := $(empty) $(empty)
 SANITIZE_SKIP := ^($(subst $(space),|,$(strip $(SANITIZE_SKIP_TESTS))))$$
@@ -71,14 +69,15 @@ test-fast: build
 test-slow: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L '^slow$$'
 
-# Everything built with AddressSanitizer + UndefinedBehaviorSanitizer in $(SANITIZE_DIR) (-O1, with
-# debug lines for the stacks), then the suite under them but the `slow` end-to-end scripts (the
-# code they run is the unit tests' code, and sanitized it takes several times as long;
-# docs/RELIABILITY.md, Sanitizers); the benchmarks are not built (no test runs them).
+# The library and its tests built with AddressSanitizer + UndefinedBehaviorSanitizer in
+# $(SANITIZE_DIR) (-O1, with debug lines for the stacks), then those tests and the fuzz replays
+# under them. Not built there, for CI's time: the front ends (the keyplace command, keyplace_tools,
+# examples; their script tests run the library code the unit tests run) and the benchmarks
+# (docs/RELIABILITY.md, Sanitizers).
 build-sanitize: deps
 	@cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DKEYPLACE_SANITIZE=ON \
-	  -DKEYPLACE_BUILD_BENCHMARKS=OFF \
+	  -DKEYPLACE_BUILD_BENCHMARKS=OFF -DKEYPLACE_BUILD_APPS=OFF -DKEYPLACE_BUILD_EXAMPLES=OFF \
 	  $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
 
