@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -16,6 +15,7 @@
 #include "config_options.hpp"
 #include "io/sqlite_magic.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/io/log_summary.hpp"
 #include "keyplace/io/ros2_bag.hpp"
 #include "keyplace/io/timestamps.hpp"
 #include "keyplace/mapping/global_map.hpp"
@@ -32,39 +32,14 @@ struct InfoOptions {
   ConfigOptions config;  // for a bag, its input section
 };
 
-double PathLength(const CarmenLog& log) {
-  double length_m = 0.0;
-  const Pose2* previous = nullptr;
-  for (const auto& scan : log.scans) {
-    const auto& pose = log.corrected ? scan.corrected_pose : scan.odometry_pose;
-    if (!pose) continue;
-    if (previous != nullptr) length_m += std::hypot(pose->x - previous->x, pose->y - previous->y);
-    previous = &*pose;
-  }
-  return length_m;
-}
-
-// How the FLASER lines' beams were spread (FlaserSpacing): "fov/n", "fov/(n-1)", "mixed", or null
-// without FLASER lines (ROBOTLASER1 lines and bags state their angles), with the scan counts.
+// How the FLASER lines' beams were spread (FlaserSpacingRule) with the scan counts, or null
+// without FLASER lines (ROBOTLASER1 lines and bags state their angles).
 nlohmann::json FlaserSpacingJson(const CarmenLog& log) {
-  const std::size_t over_n = log.flaser_scans_fov_over_beams;
-  const std::size_t over_n_minus_one = log.flaser_scans_fov_over_beams_minus_one;
-  if (over_n + over_n_minus_one == 0) return nullptr;
-  std::string rule = "mixed";
-  if (over_n_minus_one == 0) rule = ToString(FlaserSpacing::kFovOverBeams);
-  if (over_n == 0) rule = ToString(FlaserSpacing::kFovOverBeamsMinusOne);
-  return {
-      {"rule", rule}, {"scans_fov_over_n", over_n}, {"scans_fov_over_n_minus_1", over_n_minus_one}};
-}
-
-std::string FlaserSpacingText(const nlohmann::json& spacing) {
-  const auto over_n = spacing["scans_fov_over_n"].get<std::size_t>();
-  const auto over_n_minus_one = spacing["scans_fov_over_n_minus_1"].get<std::size_t>();
-  const char* even = "step fov/n from -fov/2 (even beam count, FLIRTLib's convention)";
-  const char* odd = "step fov/(n-1), first and last beam at -fov/2 and +fov/2 (odd beam count)";
-  if (over_n_minus_one == 0) return even;
-  if (over_n == 0) return odd;
-  return fmt::format("{} FLASER scans {}; {} {}", over_n, even, over_n_minus_one, odd);
+  const std::string rule = FlaserSpacingRule(log);
+  if (rule.empty()) return nullptr;
+  return {{"rule", rule},
+          {"scans_fov_over_n", log.flaser_scans_fov_over_beams},
+          {"scans_fov_over_n_minus_1", log.flaser_scans_fov_over_beams_minus_one}};
 }
 
 nlohmann::json DescribeLog(const CarmenLog& log) {
@@ -92,7 +67,7 @@ nlohmann::json DescribeLog(const CarmenLog& log) {
   const TimestampCheck stamp_check = CheckTimestamps(log.scans, TimestampSource::kLogger);
   json["timestamp_warnings"] = stamp_check.warnings;
   json["timestamps_order_scans"] = stamp_check.CanOrder();
-  json["path_length_m"] = PathLength(log);
+  json["path_length_m"] = LogPathLengthM(log);
   json["odometry_messages"] = log.odometry.size();
   json["graph_vertices"] = log.vertices.size();
   json["graph_edges"] = log.edges.size();
@@ -124,7 +99,10 @@ void PrintLog(const nlohmann::json& json) {
   }
   fmt::print("field of view   {:.1f} deg\n", json["field_of_view_deg"].get<double>());
   if (!json["flaser_beam_spacing"].is_null()) {
-    fmt::print("beam spacing    {}\n", FlaserSpacingText(json["flaser_beam_spacing"]));
+    const nlohmann::json& spacing = json["flaser_beam_spacing"];
+    fmt::print("beam spacing    {}\n",
+               FlaserSpacingText(spacing["scans_fov_over_n"].get<std::size_t>(),
+                                 spacing["scans_fov_over_n_minus_1"].get<std::size_t>()));
   }
   fmt::print("duration        {:.1f} s\n", json["duration_s"].get<double>());
   for (const auto& warning : json["timestamp_warnings"]) {
