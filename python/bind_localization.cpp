@@ -49,6 +49,14 @@ void BindPlaceMatch(py::module_& module) {
       .def_readonly("consensus", &PlaceMatch::consensus, "RANSAC consensus.")
       .def_readonly("gamma", &PlaceMatch::gamma, "Second verification (paper Eq. 10).")
       .def_readonly("reference_coverage", &PlaceMatch::reference_coverage)
+      .def_readonly("dense_checked", &PlaceMatch::dense_checked,
+                    "The query's beams were scored against the matched submap's occupancy.")
+      .def_property_readonly(
+          "dense_hit_fraction", [](const PlaceMatch& m) { return m.dense.hit_fraction; },
+          "Share of the query's endpoints in the submap's area that end on its walls.")
+      .def_property_readonly(
+          "dense_see_through", [](const PlaceMatch& m) { return m.dense.see_through_fraction; },
+          "Share of the query's beams crossing the submap's area that pass through a wall.")
       .def_readonly("score", &PlaceMatch::score)
       .def_readonly("second_score", &PlaceMatch::second_score)
       .def_readonly("confidence", &PlaceMatch::confidence, "In [0, 1].")

@@ -143,19 +143,20 @@ void WriteQueriesTsv(const std::string& path, const std::vector<LocalizationReco
     out << "start_scan\tevaluated_scan\tscans\tverified\taccepted\tambiguous\tcorrect\t"
            "matched_submap\test_x\test_y\test_theta\ttrue_x\ttrue_y\ttrue_theta\tconsensus\t"
            "gamma\tscore\tsecond_score\tconfidence\tcandidates\tseconds\treference_coverage\t"
-           "places_excluded\trevisitable\n";
+           "places_excluded\trevisitable\tdense_endpoints\tdense_hit_fraction\tdense_see_through\n";
     for (const LocalizationRecord& r : records) {
       const PlaceMatch& m = r.match;
-      fmt::print(
-          out,
-          "{}\t{}\t{}\t{:d}\t{:d}\t{:d}\t{:d}\t{}\t{:.4f}\t{:.4f}\t{:.5f}\t{:.4f}\t"
-          "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\t{:.4f}\t{}\t{:d}\n",
-          first_scan + static_cast<std::size_t>(r.start_scan),
-          first_scan + static_cast<std::size_t>(r.evaluated_scan), r.scans, m.verified, m.found,
-          m.ambiguous, r.correct, m.place_id, m.estimated_pose.x, m.estimated_pose.y,
-          m.estimated_pose.theta, r.truth.x, r.truth.y, r.truth.theta, m.consensus, m.gamma,
-          m.score, m.second_score, m.confidence, m.candidates, m.seconds, m.reference_coverage,
-          m.places_excluded, r.revisitable);
+      fmt::print(out,
+                 "{}\t{}\t{}\t{:d}\t{:d}\t{:d}\t{:d}\t{}\t{:.4f}\t{:.4f}\t{:.5f}\t{:.4f}\t"
+                 "{:.4f}\t{:.5f}\t{}\t{:.4f}\t{:.4f}\t{:.4f}\t{:.4f}\t{}\t{:.6f}\t{:.4f}\t{}\t{:d}"
+                 "\t{}\t{:.4f}\t{:.4f}\n",
+                 first_scan + static_cast<std::size_t>(r.start_scan),
+                 first_scan + static_cast<std::size_t>(r.evaluated_scan), r.scans, m.verified,
+                 m.found, m.ambiguous, r.correct, m.place_id, m.estimated_pose.x,
+                 m.estimated_pose.y, m.estimated_pose.theta, r.truth.x, r.truth.y, r.truth.theta,
+                 m.consensus, m.gamma, m.score, m.second_score, m.confidence, m.candidates,
+                 m.seconds, m.reference_coverage, m.places_excluded, r.revisitable,
+                 m.dense.endpoints, m.dense.hit_fraction, m.dense.see_through_fraction);
     }
   });
 }

@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "keyplace/place/dense_check.hpp"
+
 namespace keyplace {
 
 SubmapQueryBuilder::SubmapQueryBuilder(const MappingConfig& mapping) : mapper_(mapping) {}
@@ -11,7 +13,8 @@ bool SubmapQueryBuilder::AddScan(const LaserScan& scan, const Pose2& T_frame_rob
   // The mapper sees the scan's position in the query as its index: increasing, as in the map.
   const bool complete =
       mapper_.AddScan(static_cast<int>(scans_.size()), scan, T_frame_robot, keypoints);
-  scans_.push_back({scan_id, T_frame_robot, scan.T_robot_laser, std::move(keypoints)});
+  scans_.push_back(
+      {scan_id, T_frame_robot, scan.T_robot_laser, std::move(keypoints), DenseScanPoints(scan)});
   return complete;
 }
 
@@ -36,6 +39,12 @@ PlaceQuery SubmapQueryBuilder::Query(std::size_t evaluated_position,
         query.all_descriptors.push_back(keypoint.descriptor);
       }
     }
+  }
+  const std::size_t first_dense =
+      evaluated_position + 1 > kDenseQueryScans ? evaluated_position + 1 - kDenseQueryScans : 0;
+  for (std::size_t k = first_dense; k <= evaluated_position; ++k) {
+    query.scans.push_back(
+        InQueryFrame(scans_[k].points, Between(T_frame_origin, scans_[k].T_frame_robot)));
   }
   return query;
 }

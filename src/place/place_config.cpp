@@ -79,6 +79,14 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
                 "gamma_min for queries verified with their all-scan keypoints")
         .Double("min_reference_coverage", &C::min_reference_coverage, "",
                 "third check: share of reference keypoints in the overlap hit (0 = off)")
+        .Double("dense_min_hit_fraction", &C::dense_min_hit_fraction, "",
+                "dense veto: least share of query endpoints on the candidate's walls (0 = off)")
+        .Double("dense_max_see_through", &C::dense_max_see_through, "",
+                "dense veto: largest share of query beams passing through its walls")
+        .Double("dense_sure_hit_fraction", &C::dense_sure_hit_fraction, "",
+                "dense check passes in place of gamma: share of endpoints on the walls ...")
+        .Double("dense_sure_see_through", &C::dense_sure_see_through, "",
+                "... and largest share of beams through them")
         .Double("double_match_m", &C::double_match_m, "m",
                 "lambda: max distance of a doubly matched pair")
         .Enum("gamma_counting", &C::gamma_counting,
@@ -121,6 +129,7 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.consensus_counting = PlaceRecognitionConfig::ConsensusCounting::kQueryKeypoints;
   config.min_gamma_all_scans = 0.4;     // unused: stable query keypoints
   config.min_reference_coverage = 0.0;  // unused: stable query keypoints
+  config.dense_min_hit_fraction = 0.0;  // gamma decides, as in the paper
   config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kMeanDistance;
   return config;
 }
@@ -156,6 +165,14 @@ void Validate(const PlaceRecognitionConfig& config) {
           "min_gamma_all_scans", "must lie in [0, 1]");
   Require(config.min_reference_coverage >= 0.0 && config.min_reference_coverage <= 1.0,
           "min_reference_coverage", "must lie in [0, 1]");
+  Require(config.dense_min_hit_fraction >= 0.0 && config.dense_min_hit_fraction <= 1.0,
+          "dense_min_hit_fraction", "must lie in [0, 1]");
+  Require(config.dense_max_see_through >= 0.0 && config.dense_max_see_through <= 1.0,
+          "dense_max_see_through", "must lie in [0, 1]");
+  Require(config.dense_sure_hit_fraction >= 0.0 && config.dense_sure_hit_fraction <= 1.0,
+          "dense_sure_hit_fraction", "must lie in [0, 1]");
+  Require(config.dense_sure_see_through >= 0.0 && config.dense_sure_see_through <= 1.0,
+          "dense_sure_see_through", "must lie in [0, 1]");
   Require(config.double_match_m > 0.0, "double_match_m", "must be positive");
   Require(config.distinct_distance_m > 0.0, "distinct_distance_m", "must be positive");
   Require(config.distinct_angle_deg > 0.0, "distinct_angle_deg", "must be positive");

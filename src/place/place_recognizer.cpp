@@ -72,6 +72,8 @@ std::vector<Place> PlacesFromMap(const GlobalMap& map) {
       place.descriptors.push_back(keypoint.descriptor);
     }
     place.scan_indices = submap.scan_indices;
+    place.occupancy_cells = submap.occupancy.cells;
+    place.occupancy_cell_m = submap.occupancy.cell_size_m;
     places.push_back(std::move(place));
   }
   return places;

@@ -19,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "keyplace/place/dense_check.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 #include "keyplace/place/ransac.hpp"
 #include "place/candidate_ranking.hpp"
@@ -67,6 +68,8 @@ struct Candidate {
 // verified in parallel (a RANSAC each, grain 1).
 constexpr std::size_t kPlacesPerTask = 16;
 constexpr std::size_t kRankedCandidatesPerTask = 4;
+// Fewest query endpoints in the reference's area for a dense score to count.
+constexpr int kDenseMinEndpoints = 50;
 
 // The query keypoints paired and verified by RANSAC: the stable ones, or those of every scan
 // merged (kAllScans; the gamma check uses the stable ones either way).
@@ -230,6 +233,39 @@ std::vector<int> VerificationNeighbours(const std::vector<Place>& places, int pl
   return neighbours;
 }
 
+// The occupied cells of a place and its verification neighbours, in the place's frame. (The
+// places around the candidate within a lidar's range instead, excluded ones left out, gave fewer
+// correct and more wrong answers on FR079: overlapping submaps thicken every wall.)
+DenseReference ReferenceOccupancy(const std::vector<Place>& places, int place_index,
+                                  const std::vector<int>& neighbours) {
+  const Place& place = places[static_cast<std::size_t>(place_index)];
+  std::vector<Eigen::Vector2i> cells = place.occupancy_cells;
+  const double cell_m = place.occupancy_cell_m;
+  for (int n : neighbours) {
+    const Place& neighbour = places[static_cast<std::size_t>(n)];
+    const PointMapper T_place_neighbour(Between(place.T_world_place, neighbour.T_world_place));
+    for (const Eigen::Vector2i& cell : neighbour.occupancy_cells) {
+      const Eigen::Vector2d centre =
+          (cell.cast<double>().array() + 0.5).matrix() * neighbour.occupancy_cell_m;
+      const Eigen::Vector2d point = T_place_neighbour(centre);
+      cells.emplace_back(static_cast<int>(std::floor(point.x() / cell_m)),
+                         static_cast<int>(std::floor(point.y() / cell_m)));
+    }
+  }
+  return DenseReference(cells, cell_m);
+}
+
+// The dense score of a candidate when the query carries its beams and the place its occupancy.
+void ScoreDense(const Verification& v, int place_index, const std::vector<int>& neighbours,
+                const Pose2& T_ref_query, CandidateResult& result) {
+  const Place& place = v.places[static_cast<std::size_t>(place_index)];
+  if (v.query.scans.empty() || place.occupancy_cells.empty()) return;
+  const DenseReference reference = ReferenceOccupancy(v.places, place_index, neighbours);
+  if (reference.empty()) return;
+  result.dense = reference.Score(T_ref_query, v.query.scans);
+  result.dense_checked = true;
+}
+
 // RANSAC and the three checks of one candidate (the place's own seed: the answer does not depend
 // on which other candidates are verified, nor in which order). nullopt: not verified.
 std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Candidate& candidate,
@@ -276,15 +312,28 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
   if (!estimate.valid) return std::nullopt;
   const int consensus = CountConsensus(estimate.inliers, config.consensus_counting);
   if (consensus < config.min_consensus) return std::nullopt;  // first check
+  CandidateResult result;
+  ScoreDense(v, candidate.place_index, neighbours, estimate.T_ref_cur, result);
   const GammaResult gamma =
       ComputeGamma(*reference_positions, *reference_descriptors, v.query.positions,
                    v.query.descriptors, estimate.T_ref_cur, config.double_match_m,
                    config.descriptor_match_chi2, config.gamma_counting);
-  if (gamma.gamma < v.min_gamma) return std::nullopt;  // second check
+  // Second check. Where enough of the query's beams fall in the candidate's area they veto a
+  // pose that puts them off its walls or through them, and a pose they confirm beyond doubt
+  // needs no gamma (sparse stable keypoints make gamma small in open halls); elsewhere gamma.
+  const bool dense_applies = config.dense_min_hit_fraction > 0.0 && result.dense_checked &&
+                             result.dense.endpoints >= kDenseMinEndpoints;
+  if (dense_applies && (result.dense.hit_fraction < config.dense_min_hit_fraction ||
+                        result.dense.see_through_fraction > config.dense_max_see_through)) {
+    return std::nullopt;
+  }
+  result.dense_sure = dense_applies &&
+                      result.dense.hit_fraction >= config.dense_sure_hit_fraction &&
+                      result.dense.see_through_fraction <= config.dense_sure_see_through;
+  if (!result.dense_sure && gamma.gamma < v.min_gamma) return std::nullopt;
   const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
                                             estimate.T_ref_cur, config.ransac.inlier_distance_m);
   if (coverage < v.min_coverage) return std::nullopt;  // third check (ours)
-  CandidateResult result;
   result.place_index = candidate.place_index;
   result.pairs = static_cast<int>(candidate.pairs.size());
   result.mean_pair_distance = candidate.mean_distance;
@@ -300,6 +349,12 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
                          estimate.T_ref_cur, config.ransac.min_fit_sigma_m));
   result.score = SelectionScore(config.score, consensus, gamma.gamma);
   return result;
+}
+
+// A verified candidate passes a threshold's second check when its beams confirm it beyond doubt,
+// else by its gamma (thresholds of a sweep differ in gamma_min; the dense veto is the same).
+bool PassesSecondCheck(const CandidateResult& result, double min_gamma) {
+  return result.dense_sure || result.gamma >= min_gamma;
 }
 
 // The threads a parallel loop started here may use (the arena's, within the global control).
@@ -321,7 +376,7 @@ struct VerifiedPlaces {
     return results[static_cast<std::size_t>(slot[static_cast<std::size_t>(p)])];
   }
   bool Passes(int p, double min_gamma) const {
-    return Done(p) && Result(p) && Result(p)->gamma >= min_gamma;
+    return Done(p) && Result(p) && PassesSecondCheck(*Result(p), min_gamma);
   }
 };
 
@@ -346,23 +401,23 @@ void VerifyPlaces(const Verification& v, const std::vector<int>& order, bool fir
   }
   std::vector<char> computed(todo.size(), 0);
   std::atomic<std::size_t> first_passed{todo.size()};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, todo.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                        if (first_passing && k > first_passed.load()) return;
-                        auto& result = verified.results[first_slot + k];
-                        result = VerifyCandidate(
-                            v, v.pairing.by_place[static_cast<std::size_t>(todo[k])],
-                            neighbours[k]);
-                        computed[k] = 1;
-                        if (!first_passing || !result || result->gamma < first_passing_gamma) {
-                          continue;
-                        }
-                        std::size_t seen = first_passed.load();
-                        while (k < seen && !first_passed.compare_exchange_weak(seen, k)) {
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, todo.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+          if (first_passing && k > first_passed.load()) return;
+          auto& result = verified.results[first_slot + k];
+          result = VerifyCandidate(v, v.pairing.by_place[static_cast<std::size_t>(todo[k])],
+                                   neighbours[k]);
+          computed[k] = 1;
+          if (!first_passing || !result || !PassesSecondCheck(*result, first_passing_gamma)) {
+            continue;
+          }
+          std::size_t seen = first_passed.load();
+          while (k < seen && !first_passed.compare_exchange_weak(seen, k)) {
+          }
+        }
+      });
   for (std::size_t k = 0; k < todo.size(); ++k) {
     if (computed[k])
       verified.slot[static_cast<std::size_t>(todo[k])] = static_cast<int>(first_slot + k);
@@ -423,6 +478,8 @@ void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig
   match.consensus = best->consensus;
   match.gamma = best->gamma;
   match.reference_coverage = best->reference_coverage;
+  match.dense_checked = best->dense_checked;
+  match.dense = best->dense;
   match.score = best->score;
   match.second_score = second;
   const double consensus_factor =

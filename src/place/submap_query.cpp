@@ -1,5 +1,9 @@
 #include "place/submap_query.hpp"
 
+#include <cstddef>
+
+#include "keyplace/place/dense_check.hpp"
+
 namespace keyplace {
 
 PlaceQuery MakeSubmapQuery(const Submap& submap, const ScanSequence& sequence, int evaluated_scan,
@@ -21,6 +25,19 @@ PlaceQuery MakeSubmapQuery(const Submap& submap, const ScanSequence& sequence, i
         query.all_descriptors.push_back(keypoint.descriptor);
       }
     }
+  }
+  // The beams of the latest kDenseQueryScans scans up to the evaluated one (dense check), as
+  // SubmapQueryBuilder::Query gives them.
+  std::size_t evaluated = 0;
+  while (evaluated + 1 < submap.scan_indices.size() &&
+         submap.scan_indices[evaluated] != evaluated_scan) {
+    ++evaluated;
+  }
+  const std::size_t first = evaluated + 1 > kDenseQueryScans ? evaluated + 1 - kDenseQueryScans : 0;
+  for (std::size_t k = first; k <= evaluated; ++k) {
+    const int scan = submap.scan_indices[k];
+    query.scans.push_back(InQueryFrame(DenseScanPoints(sequence.scans[scan]),
+                                       Between(submap.origin(), sequence.poses[scan])));
   }
   return query;
 }

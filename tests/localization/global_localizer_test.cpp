@@ -233,5 +233,32 @@ TEST(GlobalLocalizer, LocalizeScanFindsASingleScanAmongScanPlaces) {
   EXPECT_EQ(result.scans, 1u);
 }
 
+// The query carries the beams of its last kDenseQueryScans scans for the dense check, thinned to
+// kDenseBeamsPerScan, in the query frame (the first scan's pose).
+TEST(SubmapQueryBuilder, QueryCarriesTheLatestScansBeamsInItsFrame) {
+  std::vector<double> ranges(361, 4.0);
+  std::vector<double> angles;
+  for (int k = 0; k < 361; ++k) angles.push_back(-M_PI / 2 + k * M_PI / 360);
+  ranges[7] = 100.0;  // beyond max range: not a beam
+  const LaserScan scan = MakeLaserScan(ranges, angles, 80.0, 0.0, Pose2(0.2, 0.0, 0.0));
+  MappingConfig mapping;
+  mapping.max_scans_per_submap = 1000;
+  SubmapQueryBuilder builder(mapping);
+  for (int k = 0; k < 14; ++k) builder.AddScan(scan, Pose2(0.1 * k, 0.0, 0.05 * k), {}, k);
+  const PlaceQuery query = builder.Query(12, PlaceRecognitionConfig::QueryKeypoints::kAllScans);
+  ASSERT_EQ(query.scans.size(), kDenseQueryScans);  // scans 3..12
+  for (const QueryScanPoints& points : query.scans) {
+    EXPECT_LE(points.endpoints_m.size(), kDenseBeamsPerScan);
+    EXPECT_GE(points.endpoints_m.size(), kDenseBeamsPerScan / 2);
+  }
+  // Scan 12's laser sits at T_query_robot * (0.2, 0) and every endpoint 4 m from it.
+  const Pose2 T_query_robot = Between(Pose2(0.0, 0.0, 0.0), Pose2(1.2, 0.0, 0.6));
+  const Eigen::Vector2d laser = T_query_robot * Eigen::Vector2d(0.2, 0.0);
+  EXPECT_NEAR((query.scans.back().origin_m - laser).norm(), 0.0, 1e-12);
+  for (const Eigen::Vector2d& endpoint : query.scans.back().endpoints_m) {
+    EXPECT_NEAR((endpoint - laser).norm(), 4.0, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace keyplace

@@ -140,31 +140,41 @@ TEST(RecognitionThresholds, InvalidThresholdsAreRefusedNamingThem) {
   }
 }
 
-// The evaluation records of each threshold are those of EvaluateQueries with it.
-TEST(RecognitionThresholds, EvaluateQueriesAtThresholdsMatchesEvaluateQueries) {
+// The evaluation records of each threshold are those of EvaluateQueries with it; returns how
+// many queries the two thresholds answer differently.
+int ExpectThresholdsMatchEvaluateQueries(const PlaceRecognitionConfig& base) {
   const std::vector<LocalizationQuery> queries = Queries();
   const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
-  const PlaceRecognitionConfig base = PlacePreset("default");
   const std::vector<RecognitionThresholds> thresholds{{5, 0.0, 0.0}, {10, 0.4, 0.3}};
   const auto records = EvaluateQueriesAtThresholds(queries, PlaceRecognizer(places, base),
                                                    SelfMatchRule::kSameScans, thresholds);
-  ASSERT_EQ(records.size(), thresholds.size());
-  int correct_differs = 0;
-  for (std::size_t k = 0; k < thresholds.size(); ++k) {
+  EXPECT_EQ(records.size(), thresholds.size());
+  int differs = 0;
+  for (std::size_t k = 0; k < thresholds.size() && k < records.size(); ++k) {
     const auto expected =
         EvaluateQueries(queries, PlaceRecognizer(places, WithThresholds(base, thresholds[k])),
                         SelfMatchRule::kSameScans);
-    ASSERT_EQ(records[k].size(), expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(records[k].size(), expected.size());
+    for (std::size_t i = 0; i < expected.size() && i < records[k].size(); ++i) {
       const std::string where = "thresholds " + std::to_string(k) + ", query " + std::to_string(i);
       EXPECT_EQ(records[k][i].start_scan, expected[i].start_scan) << where;
       EXPECT_EQ(records[k][i].correct, expected[i].correct) << where;
       EXPECT_EQ(records[k][i].verified_correct, expected[i].verified_correct) << where;
       testing::ExpectSameMatch(records[k][i].match, expected[i].match, where);
-      if (k == 1) correct_differs += records[0][i].match.found != records[1][i].match.found;
+      if (k == 1) differs += records[0][i].match.found != records[1][i].match.found;
     }
   }
-  EXPECT_GT(correct_differs, 0) << "the two thresholds gave the same answers: nothing was tested";
+  return differs;
+}
+
+TEST(RecognitionThresholds, EvaluateQueriesAtThresholdsMatchesEvaluateQueries) {
+  // Gamma decides the second check (dense check off): the thresholds must change answers.
+  PlaceRecognitionConfig gamma = PlacePreset("default");
+  gamma.dense_min_hit_fraction = 0.0;
+  EXPECT_GT(ExpectThresholdsMatchEvaluateQueries(gamma), 0)
+      << "the two thresholds gave the same answers: nothing was tested";
+  // The default, where the dense check decides in place of gamma wherever it applies.
+  ExpectThresholdsMatchEvaluateQueries(PlacePreset("default"));
 }
 
 }  // namespace

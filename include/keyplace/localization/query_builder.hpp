@@ -29,7 +29,8 @@ class SubmapQueryBuilder {
 
   /// The query of the submap as it stands: its stable keypoints in its frame (the first scan's
   /// pose), the pose to estimate = the scan at `evaluated_position` (0-based among the added
-  /// scans) and, for QueryKeypoints::kAllScans, every keypoint of every scan, latest first.
+  /// scans), for QueryKeypoints::kAllScans every keypoint of every scan, latest first, and the
+  /// beams of the latest kDenseQueryScans scans up to `evaluated_position` (PlaceQuery::scans).
   PlaceQuery Query(std::size_t evaluated_position,
                    PlaceRecognitionConfig::QueryKeypoints query_keypoints) const;
 
@@ -47,6 +48,7 @@ class SubmapQueryBuilder {
     Pose2 T_frame_robot;
     Pose2 T_robot_laser;
     std::vector<Keypoint> keypoints;
+    QueryScanPoints points;  // robot frame, a subset of the beams (dense check)
   };
   LocalMapper mapper_;
   std::deque<Buffered> scans_;

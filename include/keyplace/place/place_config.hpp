@@ -71,6 +71,18 @@ struct PlaceRecognitionConfig {
   // those inliers (several query keypoints on one reference keypoint count once).
   enum class ConsensusCounting { kQueryKeypoints, kDistinctReference };
   ConsensusCounting consensus_counting = ConsensusCounting::kDistinctReference;
+  // Dense check (beyond the paper; place/dense_check.hpp, docs/PLACE.md "Dense check"), for a
+  // query that carries its scans' beams (PlaceQuery::scans) with enough of them ending in the
+  // candidate's area. Veto: fewer than dense_min_hit_fraction of those endpoints on the
+  // candidate's occupied cells, or more than dense_max_see_through of the beams crossing its
+  // area passing through one, refuse the candidate whatever its keypoints say. Sure: at least
+  // dense_sure_hit_fraction on them and at most dense_sure_see_through through them pass the
+  // second check in place of gamma. dense_min_hit_fraction 0 = off. All four chosen on FR079 and
+  // Intel (docs/PLACE.md).
+  double dense_min_hit_fraction = 0.5;
+  double dense_max_see_through = 0.3;
+  double dense_sure_hit_fraction = 0.8;
+  double dense_sure_see_through = 0.1;
   double min_gamma = 0.4;  // gamma_min: second check, Eq. (10), for stable query keypoints
   // gamma_min when the query was paired and verified with its all-scan keypoints (kAllScans and
   // PlaceQuery::all_positions given): lower, because that consensus already rejects wrong

@@ -17,6 +17,7 @@
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/features/descriptor.hpp"
 #include "keyplace/mapping/global_map.hpp"
+#include "keyplace/place/dense_check.hpp"
 #include "keyplace/place/place_config.hpp"
 
 namespace keyplace {
@@ -27,6 +28,10 @@ struct Place {
   std::vector<Eigen::Vector2d> positions;       // keypoints, place frame
   std::vector<BetaGridDescriptor> descriptors;  // same order
   std::vector<int> scan_indices;                // scans the place was built from
+  // Optional, for the dense check: the cells its scans' beams ended in (Submap::occupancy), in
+  // the place frame, of occupancy_cell_m. Empty: the place is judged by its keypoints alone.
+  std::vector<Eigen::Vector2i> occupancy_cells;
+  double occupancy_cell_m = 0.0;
 };
 
 /// One place per submap, in map order (keypoints in the submap frame, T_world_place = P[0]).
@@ -42,6 +47,9 @@ struct PlaceQuery {
   // PlaceRecognitionConfig::QueryKeypoints::kAllScans; may hold near-duplicates, merged there).
   std::vector<Eigen::Vector2d> all_positions;
   std::vector<BetaGridDescriptor> all_descriptors;
+  // Optional: the latest scans' beams in the same frame, for the dense check
+  // (PlaceRecognitionConfig::dense_min_hit_fraction). Empty: keypoints alone decide.
+  std::vector<QueryScanPoints> scans;
 };
 
 /// Greedy merge: keeps each keypoint unless one already kept lies within `radius_m` (input order
@@ -98,7 +106,13 @@ struct CandidateResult {
   int consensus = 0;
   double gamma = 0.0;
   double reference_coverage = 0.0;  // see ReferenceCoverage, with the RANSAC query keypoints
-  bool verified = false;            // passed all checks
+  // The dense score, when the query has its scans and the place its occupancy, and whether it
+  // confirmed the pose beyond doubt, which passes the second check whatever gamma
+  // (PlaceRecognitionConfig::dense_sure_hit_fraction).
+  bool dense_checked = false;
+  bool dense_sure = false;
+  DenseScore dense;
+  bool verified = false;  // passed all checks
   Pose2 T_ref_cur;
   Pose2 estimated_pose;  // Eq. (9)
   // Covariance of estimated_pose over its (x, y, theta) (world frame): RigidFitCovariance of the
@@ -125,6 +139,8 @@ struct PlaceMatch {
   int consensus = 0;
   double gamma = 0.0;
   double reference_coverage = 0.0;
+  bool dense_checked = false;  // of the answer (CandidateResult)
+  DenseScore dense;
   double score = 0.0;
   double second_score = 0.0;  // best distinct verified candidate (0 if none)
   // In [0, 1]: min(1, consensus / confidence_consensus) * gamma * (1 - second_score / score).

@@ -1,0 +1,145 @@
+#include "keyplace/place/dense_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+
+namespace keyplace {
+namespace {
+
+constexpr std::uint8_t kOccupied = 1;
+constexpr std::uint8_t kNearOccupied = 2;
+// A raster larger than this (a reference of several submaps spanning more than 400 m at 0.1 m)
+// is not built: the check then does not apply (DenseReference::empty).
+constexpr std::int64_t kMaxRasterCells = std::int64_t{1} << 24;
+
+}  // namespace
+
+QueryScanPoints DenseScanPoints(const LaserScan& scan) {
+  QueryScanPoints points;
+  points.origin_m = scan.T_robot_laser.translation();
+  const std::size_t valid = scan.CountValid();
+  if (valid == 0) return points;
+  const std::size_t stride = (valid + kDenseBeamsPerScan - 1) / kDenseBeamsPerScan;
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (!scan.valid[i]) continue;
+    if (seen++ % stride == 0) points.endpoints_m.push_back(scan.T_robot_laser * scan.Endpoint(i));
+  }
+  return points;
+}
+
+QueryScanPoints InQueryFrame(const QueryScanPoints& points, const Pose2& T_query_robot) {
+  const PointMapper to_query(T_query_robot);
+  QueryScanPoints out;
+  out.origin_m = to_query(points.origin_m);
+  out.endpoints_m.reserve(points.endpoints_m.size());
+  for (const Eigen::Vector2d& endpoint : points.endpoints_m) {
+    out.endpoints_m.push_back(to_query(endpoint));
+  }
+  return out;
+}
+
+DenseReference::DenseReference(const std::vector<Eigen::Vector2i>& cells, double cell_size_m)
+    : cell_size_m_(cell_size_m) {
+  if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {
+    throw std::invalid_argument("DenseReference: the cell size must be positive and finite");
+  }
+  if (cells.empty()) return;
+  min_cell_ = cells.front();
+  max_cell_ = cells.front();
+  for (const Eigen::Vector2i& cell : cells) {
+    min_cell_ = min_cell_.cwiseMin(cell);
+    max_cell_ = max_cell_.cwiseMax(cell);
+  }
+  const int radius = static_cast<int>(std::ceil(kDenseHitDistanceM / cell_size_m_));
+  margin_ = radius;
+  const std::int64_t width = std::int64_t{max_cell_.x()} - min_cell_.x() + 1 + 2 * margin_;
+  const std::int64_t height = std::int64_t{max_cell_.y()} - min_cell_.y() + 1 + 2 * margin_;
+  if (width * height > kMaxRasterCells) return;
+  width_ = static_cast<int>(width);
+  height_ = static_cast<int>(height);
+  flags_.assign(static_cast<std::size_t>(width * height), 0);
+  const int radius2 = radius * radius;
+  for (const Eigen::Vector2i& cell : cells) {
+    const int ci = cell.x() - min_cell_.x() + margin_;
+    const int cj = cell.y() - min_cell_.y() + margin_;
+    for (int di = -radius; di <= radius; ++di) {
+      for (int dj = -radius; dj <= radius; ++dj) {
+        if (di * di + dj * dj > radius2) continue;
+        flags_[static_cast<std::size_t>(cj + dj) * static_cast<std::size_t>(width_) +
+               static_cast<std::size_t>(ci + di)] |= kNearOccupied;
+      }
+    }
+    flags_[static_cast<std::size_t>(cj) * static_cast<std::size_t>(width_) +
+           static_cast<std::size_t>(ci)] |= kOccupied;
+  }
+}
+
+std::uint8_t DenseReference::FlagsAt(const Eigen::Vector2d& point_m) const {
+  const double i = std::floor(point_m.x() / cell_size_m_) - min_cell_.x() + margin_;
+  const double j = std::floor(point_m.y() / cell_size_m_) - min_cell_.y() + margin_;
+  if (!(i >= 0.0 && j >= 0.0 && i < width_ && j < height_)) return 0;
+  return flags_[static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) +
+                static_cast<std::size_t>(i)];
+}
+
+bool DenseReference::Inside(const Eigen::Vector2d& point_m) const {
+  const double i = std::floor(point_m.x() / cell_size_m_);
+  const double j = std::floor(point_m.y() / cell_size_m_);
+  return i >= min_cell_.x() && i <= max_cell_.x() && j >= min_cell_.y() && j <= max_cell_.y();
+}
+
+// Samples the beam every half cell up to kDenseSeeThroughMarginM short of its endpoint. A beam
+// sees through when it enters an occupied cell and, kDenseWallCrossingM further on, is clear of
+// every occupied cell: it crossed a wall. A beam grazing a wall (within about 35 degrees of it)
+// stays near it over that stretch and is not counted: at 0.1 m cells the map cannot tell on
+// which side of a wall such a beam runs.
+bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::Vector2d& endpoint_m,
+                                 bool& crossed) const {
+  crossed = false;
+  const Eigen::Vector2d beam = endpoint_m - origin_m;
+  const double length = beam.norm();
+  const double free_length = length - kDenseSeeThroughMarginM;
+  if (!(free_length > 0.0)) return false;
+  const Eigen::Vector2d direction = beam / length;
+  const double step = 0.5 * cell_size_m_;
+  for (double s = 0.0; s < free_length; s += step) {
+    const Eigen::Vector2d point = origin_m + s * direction;
+    if (!Inside(point)) continue;
+    crossed = true;
+    if (!(FlagsAt(point) & kOccupied)) continue;
+    const double beyond = s + kDenseWallCrossingM;
+    if (beyond < free_length && !(FlagsAt(origin_m + beyond * direction) & kNearOccupied)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+DenseScore DenseReference::Score(const Pose2& T_ref_query,
+                                 const std::vector<QueryScanPoints>& scans) const {
+  DenseScore score;
+  if (empty()) return score;
+  int hits = 0;
+  int seen_through = 0;
+  for (const QueryScanPoints& scan : scans) {
+    const Eigen::Vector2d origin = T_ref_query * scan.origin_m;
+    for (const Eigen::Vector2d& endpoint_query : scan.endpoints_m) {
+      const Eigen::Vector2d endpoint = T_ref_query * endpoint_query;
+      if (Inside(endpoint)) {
+        ++score.endpoints;
+        if (FlagsAt(endpoint) & kNearOccupied) ++hits;
+      }
+      bool crossed = false;
+      if (SeesThrough(origin, endpoint, crossed)) ++seen_through;
+      if (crossed) ++score.rays;
+    }
+  }
+  if (score.endpoints > 0) score.hit_fraction = static_cast<double>(hits) / score.endpoints;
+  if (score.rays > 0) score.see_through_fraction = static_cast<double>(seen_through) / score.rays;
+  return score;
+}
+
+}  // namespace keyplace

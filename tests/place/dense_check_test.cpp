@@ -1,0 +1,205 @@
+// The dense check on synthetic rooms: the true pose scores high and a wrong one low or through a
+// wall; in recognition it turns a keypoint match that gamma refuses (an open hall with sparse
+// keypoints) into an answer, and refuses one whose walls do not fit (a look-alike).
+
+#include "keyplace/place/dense_check.hpp"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/place/place_recognizer.hpp"
+
+namespace keyplace {
+namespace {
+
+using Segment = std::pair<Eigen::Vector2d, Eigen::Vector2d>;
+
+// A 12 m x 8 m room with an inner wall and a pillar, in the world frame.
+std::vector<Segment> Room() {
+  const auto s = [](double x0, double y0, double x1, double y1) {
+    return Segment{Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y1)};
+  };
+  return {s(0, 0, 12, 0), s(12, 0, 12, 8), s(12, 8, 0, 8), s(0, 8, 0, 0), s(5, 0, 5, 4.5),
+          s(8, 5, 9, 5),  s(9, 5, 9, 6),   s(9, 6, 8, 6),  s(8, 6, 8, 5)};
+}
+
+std::optional<double> RayHit(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
+                             const Segment& wall) {
+  const Eigen::Vector2d edge = wall.second - wall.first;
+  const double denominator = direction.x() * edge.y() - direction.y() * edge.x();
+  if (std::abs(denominator) < 1e-12) return std::nullopt;
+  const Eigen::Vector2d to_wall = wall.first - origin;
+  const double t = (to_wall.x() * edge.y() - to_wall.y() * edge.x()) / denominator;
+  const double u = (to_wall.x() * direction.y() - to_wall.y() * direction.x()) / denominator;
+  if (t <= 1e-9 || u < 0.0 || u > 1.0) return std::nullopt;
+  return t;
+}
+
+// 360 beams over 360 degrees from T_world_laser: endpoints in the laser frame.
+std::vector<Eigen::Vector2d> CastScan(const std::vector<Segment>& walls,
+                                      const Pose2& T_world_laser) {
+  std::vector<Eigen::Vector2d> endpoints;
+  for (int k = 0; k < 360; ++k) {
+    const double bearing = k * M_PI / 180.0;
+    const Eigen::Vector2d local(std::cos(bearing), std::sin(bearing));
+    const Eigen::Vector2d direction = T_world_laser * local - T_world_laser.translation();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Segment& wall : walls) {
+      if (const auto t = RayHit(T_world_laser.translation(), direction, wall)) {
+        nearest = std::min(nearest, *t);
+      }
+    }
+    if (std::isfinite(nearest)) endpoints.push_back(nearest * local);
+  }
+  return endpoints;
+}
+
+// The cells (0.1 m) the scans from `poses` end in, in the frame of poses[0] (a submap's).
+std::vector<Eigen::Vector2i> OccupiedCells(const std::vector<Segment>& walls,
+                                           const std::vector<Pose2>& poses) {
+  std::set<std::pair<int, int>> cells;
+  for (const Pose2& pose : poses) {
+    const Pose2 T_place_laser = Between(poses.front(), pose);
+    for (const Eigen::Vector2d& endpoint : CastScan(walls, pose)) {
+      const Eigen::Vector2d p = T_place_laser * endpoint;
+      cells.emplace(static_cast<int>(std::floor(p.x() / 0.1)),
+                    static_cast<int>(std::floor(p.y() / 0.1)));
+    }
+  }
+  std::vector<Eigen::Vector2i> out;
+  for (const auto& [i, j] : cells) out.emplace_back(i, j);
+  return out;
+}
+
+// Query scans taken at `poses` (world), in the frame of poses[0].
+std::vector<QueryScanPoints> QueryScans(const std::vector<Segment>& walls,
+                                        const std::vector<Pose2>& poses) {
+  std::vector<QueryScanPoints> scans;
+  for (const Pose2& pose : poses) {
+    const Pose2 T_query_laser = Between(poses.front(), pose);
+    QueryScanPoints scan;
+    scan.origin_m = T_query_laser.translation();
+    for (const Eigen::Vector2d& endpoint : CastScan(walls, pose)) {
+      scan.endpoints_m.push_back(T_query_laser * endpoint);
+    }
+    scans.push_back(std::move(scan));
+  }
+  return scans;
+}
+
+const std::vector<Pose2> kMapPoses{{2.0, 2.0, 0.0}, {2.5, 2.5, 0.1}, {3.0, 3.0, 0.2}};
+const std::vector<Pose2> kQueryPoses{{2.3, 5.5, -1.0}, {2.8, 5.2, -0.9}, {3.2, 5.0, -0.8}};
+
+TEST(DenseReference, TheTruePoseHitsTheWallsAndWrongOnesDoNot) {
+  const DenseReference reference(OccupiedCells(Room(), kMapPoses), 0.1);
+  const std::vector<QueryScanPoints> scans = QueryScans(Room(), kQueryPoses);
+  const Pose2 T_ref_query = Between(kMapPoses.front(), kQueryPoses.front());
+
+  const DenseScore right = reference.Score(T_ref_query, scans);
+  EXPECT_GT(right.endpoints, 500);
+  EXPECT_GT(right.hit_fraction, 0.9);
+  EXPECT_LT(right.see_through_fraction, 0.05);
+
+  // Half a metre off: most endpoints miss the walls by more than the hit distance.
+  const DenseScore shifted = reference.Score(Pose2(0.5, 0.0, 0.0) * T_ref_query, scans);
+  EXPECT_LT(shifted.hit_fraction, 0.5);
+  // Turned by 90 degrees about the query's first pose: beams cross the room's walls.
+  const DenseScore turned = reference.Score(T_ref_query * Pose2(0.0, 0.0, M_PI / 2), scans);
+  EXPECT_LT(turned.hit_fraction, 0.5);
+  EXPECT_GT(turned.see_through_fraction, 0.2);
+}
+
+TEST(DenseReference, EndpointsOutsideTheReferenceCountForNothing) {
+  const DenseReference reference(OccupiedCells(Room(), kMapPoses), 0.1);
+  const std::vector<QueryScanPoints> scans = QueryScans(Room(), kQueryPoses);
+  const DenseScore far = reference.Score(Pose2(100.0, 100.0, 0.0), scans);
+  EXPECT_EQ(far.endpoints, 0);
+  EXPECT_EQ(far.rays, 0);
+  EXPECT_EQ(far.hit_fraction, 0.0);
+  EXPECT_TRUE(DenseReference({}, 0.1).empty());
+  EXPECT_THROW(DenseReference({}, 0.0), std::invalid_argument);
+}
+
+// Keypoints on the room's walls with distinct descriptors, in the place frame (kMapPoses[0]).
+BetaGridDescriptor Descriptor(int code) {
+  BetaGridDescriptor d{};
+  d[static_cast<std::size_t>(code % kBetaGridBins)] = 1.0f;
+  return d;
+}
+
+// An open hall as the keypoints see it: a place and a query that share 12 keypoints (enough
+// consensus) while the query's own stable keypoints are elsewhere, so gamma is 0.
+std::pair<Place, PlaceQuery> SparseMatch(const std::vector<Segment>& query_walls) {
+  Place place;
+  place.id = 0;
+  place.T_world_place = kMapPoses.front();
+  place.scan_indices = {0, 1, 2};
+  place.occupancy_cells = OccupiedCells(Room(), kMapPoses);
+  place.occupancy_cell_m = 0.1;
+  PlaceQuery query;
+  const Pose2 T_query_place = Between(kQueryPoses.front(), kMapPoses.front());
+  for (int k = 0; k < 12; ++k) {
+    const Eigen::Vector2d world(0.5 + 0.9 * k, k % 2 == 0 ? 0.0 : 8.0);
+    place.positions.push_back(kMapPoses.front().inverse() * world);
+    place.descriptors.push_back(Descriptor(k));
+    query.all_positions.push_back(T_query_place * place.positions.back());
+    query.all_descriptors.push_back(Descriptor(k));
+  }
+  for (int k = 0; k < 4; ++k) {  // stable query keypoints that double-match nothing
+    query.positions.emplace_back(20.0 + k, 20.0);
+    query.descriptors.push_back(Descriptor(40 + k));
+  }
+  query.scans = QueryScans(query_walls, kQueryPoses);
+  return {place, query};
+}
+
+TEST(DenseCheck, BeamsThatConfirmThePosePassInPlaceOfGamma) {
+  const auto [place, query] = SparseMatch(Room());
+  PlaceRecognitionConfig gamma_only;
+  gamma_only.dense_min_hit_fraction = 0.0;
+  const PlaceMatch refused = PlaceRecognizer({place}, gamma_only).Recognize(query);
+  EXPECT_FALSE(refused.verified);  // gamma 0 < 0.15
+
+  const PlaceMatch answered = PlaceRecognizer({place}, PlaceRecognitionConfig{}).Recognize(query);
+  ASSERT_TRUE(answered.found);
+  EXPECT_TRUE(answered.dense_checked);
+  EXPECT_TRUE(answered.verified_candidates.front().dense_sure);
+  EXPECT_GT(answered.dense.hit_fraction, 0.9);
+  EXPECT_EQ(answered.gamma, 0.0);
+  const Pose2& expected = kQueryPoses.front();  // T_first_evaluated is the identity
+  EXPECT_NEAR(answered.estimated_pose.x, expected.x, 1e-6);
+  EXPECT_NEAR(answered.estimated_pose.y, expected.y, 1e-6);
+
+  // Without the query's beams the check cannot apply and gamma decides again.
+  PlaceQuery without_scans = query;
+  without_scans.scans.clear();
+  EXPECT_FALSE(
+      PlaceRecognizer({place}, PlaceRecognitionConfig{}).Recognize(without_scans).verified);
+}
+
+TEST(DenseCheck, RefusesALookAlikeWhoseWallsDoNotFit) {
+  // The same keypoints, but the query was taken in a room without the inner wall, with its
+  // pillar elsewhere and 1 m shorter: the keypoints agree, the beams do not.
+  const std::vector<Segment> other{{{0, 0}, {12, 0}}, {{12, 0}, {12, 7}}, {{12, 7}, {0, 7}},
+                                   {{0, 7}, {0, 0}},  {{3, 2}, {4, 2}},   {{4, 2}, {4, 3}}};
+  const auto [place, query] = SparseMatch(other);
+  PlaceRecognitionConfig keypoints_accept;
+  keypoints_accept.dense_min_hit_fraction = 0.0;
+  keypoints_accept.min_gamma_all_scans = 0.0;
+  EXPECT_TRUE(PlaceRecognizer({place}, keypoints_accept).Recognize(query).found);
+
+  // The veto: gamma passes (its threshold is 0), the beams refuse.
+  PlaceRecognitionConfig dense = keypoints_accept;
+  dense.dense_min_hit_fraction = PlaceRecognitionConfig{}.dense_min_hit_fraction;
+  const PlaceMatch match = PlaceRecognizer({place}, dense).Recognize(query);
+  EXPECT_FALSE(match.verified);
+}
+
+}  // namespace
+}  // namespace keyplace
