@@ -87,13 +87,19 @@ std::string CacheEntryPath(const std::string& dir, const std::string& kind,
   return dir + "/" + kind + "-" + Hex64(Fnv1a64Of(key.data(), key.size())) + ".bin";
 }
 
-CacheRead ReadCacheEntry(const std::string& path, const std::string& key) {
+CacheRead ReadCacheEntry(const std::string& path, const std::string& key, std::uint64_t max_bytes) {
   CacheRead read;
   std::error_code status_error;
   const auto status = std::filesystem::status(path, status_error);
   if (status.type() == std::filesystem::file_type::not_found) return read;  // no entry yet
   if (status.type() != std::filesystem::file_type::regular) {  // a FIFO would never end
     read.problem = "is not a regular file";
+    return read;
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, status_error);
+  if (!status_error && size > max_bytes) {
+    read.problem = "holds " + std::to_string(size) + " bytes, more than the " +
+                   std::to_string(max_bytes) + " an entry may have";
     return read;
   }
   std::ifstream file(path, std::ios::binary);

@@ -15,6 +15,7 @@
 //   | u64 FNV-1a 64 of every byte before it.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,7 +35,13 @@ struct CacheRead {
   std::string problem;
 };
 
-CacheRead ReadCacheEntry(const std::string& path, const std::string& key);
+/// The largest entry read (it is read whole): keypoints of about 80 times FR079's raw log. A
+/// larger file is a damaged or foreign one, named and computed again, not a reason to run out of
+/// memory.
+constexpr std::uint64_t kMaxCacheEntryBytes = std::uint64_t{2} << 30;
+
+CacheRead ReadCacheEntry(const std::string& path, const std::string& key,
+                         std::uint64_t max_bytes = kMaxCacheEntryBytes);
 
 /// Writes the entry atomically (temporary file, then rename). Throws std::runtime_error naming
 /// the path when it cannot be written.

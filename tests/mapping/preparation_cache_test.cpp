@@ -191,6 +191,21 @@ TEST(PreparationCache, AnEntryThatIsNotAFileIsNamedAndTheRunGoesOn) {
   ExpectSamePreparation(reference, run);
 }
 
+TEST(PreparationCache, AnEntryLargerThanTheLimitIsNotReadAndSaysSo) {
+  const std::string dir = testing::MakeTempDir("prep_cache_too_large");
+  const std::string path = dir + "/entry.bin";
+  mapping_internal::WriteCacheEntry(path, "key", std::string(1000, 'p'));
+  const auto size = static_cast<std::uint64_t>(fs::file_size(path));
+  const mapping_internal::CacheRead whole = mapping_internal::ReadCacheEntry(path, "key", size);
+  ASSERT_TRUE(whole.payload.has_value()) << whole.problem;
+  EXPECT_EQ(whole.payload->size(), 1000u);
+  const mapping_internal::CacheRead refused =
+      mapping_internal::ReadCacheEntry(path, "key", size - 1);
+  EXPECT_FALSE(refused.payload.has_value());
+  testing::ExpectContains(refused.problem, "holds " + std::to_string(size) +
+                                               " bytes, more than the " + std::to_string(size - 1));
+}
+
 TEST(PreparationCache, AnEntryOfTheWrongSizeIsRefusedSayingWhat) {
   using mapping_internal::DecodeKeypoints;
   using mapping_internal::DecodePoses;
