@@ -35,9 +35,9 @@ struct CacheRead {
   std::string problem;
 };
 
-/// The largest entry read (it is read whole): keypoints of about 80 times FR079's raw log. A
-/// larger file is a damaged or foreign one, named and computed again, not a reason to run out of
-/// memory.
+/// The largest entry read (it is read whole): 80 times the largest keypoint entry of the shared
+/// logs (26 MB). A larger file is a damaged or foreign one, named and computed again, not a
+/// reason to run out of memory.
 constexpr std::uint64_t kMaxCacheEntryBytes = std::uint64_t{2} << 30;
 
 CacheRead ReadCacheEntry(const std::string& path, const std::string& key,
