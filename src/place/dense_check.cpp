@@ -55,8 +55,10 @@ DenseReference::DenseReference(const std::vector<Eigen::Vector2i>& cells, double
   }
   const int radius = static_cast<int>(std::ceil(kDenseHitDistanceM / cell_size_m_));
   margin_ = radius;
-  const std::int64_t width = std::int64_t{max_cell_.x()} - min_cell_.x() + 1 + 2 * margin_;
-  const std::int64_t height = std::int64_t{max_cell_.y()} - min_cell_.y() + 1 + 2 * margin_;
+  const std::int64_t width =
+      std::int64_t{max_cell_.x()} - min_cell_.x() + 1 + std::int64_t{2} * margin_;
+  const std::int64_t height =
+      std::int64_t{max_cell_.y()} - min_cell_.y() + 1 + std::int64_t{2} * margin_;
   if (width * height > kMaxRasterCells) return;
   width_ = static_cast<int>(width);
   height_ = static_cast<int>(height);
@@ -104,8 +106,29 @@ bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::V
   const double free_length = length - kDenseSeeThroughMarginM;
   if (!(free_length > 0.0)) return false;
   const Eigen::Vector2d direction = beam / length;
+  // Only the stretch inside the occupied box can cross anything (slab clipping): the samples are
+  // bounded by the box, not by the beam's length.
+  double enter = 0.0;
+  double leave = free_length;
+  const Eigen::Vector2d box_min = min_cell_.cast<double>() * cell_size_m_;
+  const Eigen::Vector2d box_max = (max_cell_.cast<double>().array() + 1.0).matrix() * cell_size_m_;
+  for (int axis = 0; axis < 2; ++axis) {
+    if (direction[axis] == 0.0) {
+      if (origin_m[axis] < box_min[axis] || origin_m[axis] > box_max[axis]) return false;
+      continue;
+    }
+    const double a = (box_min[axis] - origin_m[axis]) / direction[axis];
+    const double b = (box_max[axis] - origin_m[axis]) / direction[axis];
+    enter = std::max(enter, std::min(a, b));
+    leave = std::min(leave, std::max(a, b));
+  }
+  if (!(enter <= leave)) return false;
   const double step = 0.5 * cell_size_m_;
-  for (double s = 0.0; s < free_length; s += step) {
+  const auto first = static_cast<std::int64_t>(std::floor(enter / step));
+  const auto last = static_cast<std::int64_t>(std::ceil(leave / step));
+  for (std::int64_t k = first; k <= last; ++k) {
+    const double s = static_cast<double>(k) * step;
+    if (s < 0.0 || s >= free_length) continue;
     const Eigen::Vector2d point = origin_m + s * direction;
     if (!Inside(point)) continue;
     crossed = true;

@@ -122,6 +122,14 @@ TEST(DenseReference, EndpointsOutsideTheReferenceCountForNothing) {
   EXPECT_EQ(far.endpoints, 0);
   EXPECT_EQ(far.rays, 0);
   EXPECT_EQ(far.hit_fraction, 0.0);
+  // A beam a million kilometres long is walked only where it crosses the reference: it passes
+  // through the room's wall, and the walk is bounded by the room, not by the beam.
+  QueryScanPoints far_beam;
+  far_beam.origin_m = Eigen::Vector2d(1.0, 1.0);
+  far_beam.endpoints_m.emplace_back(1.0e9, 1.0);
+  const DenseScore through = reference.Score(Pose2(), {far_beam});
+  EXPECT_EQ(through.rays, 1);
+  EXPECT_EQ(through.see_through_fraction, 1.0);
   EXPECT_TRUE(DenseReference({}, 0.1).empty());
   EXPECT_THROW(DenseReference({}, 0.0), std::invalid_argument);
 }
