@@ -13,6 +13,11 @@ void Require(bool ok, const std::string& field, const std::string& rule) {
   if (!ok) throw std::invalid_argument("PlaceRecognitionConfig." + field + " " + rule);
 }
 
+// A share or a probability: NaN fails too.
+void RequireFraction(double value, const std::string& field) {
+  Require(value >= 0.0 && value <= 1.0, field, "must lie in [0, 1]");
+}
+
 }  // namespace
 
 const ConfigFields<RansacConfig>& RansacConfigFields() {
@@ -160,25 +165,18 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.ransac.min_fit_sigma_m >= 0.0, "ransac.min_fit_sigma_m", "must be >= 0");
   Require(config.verification_neighbours >= 0, "verification_neighbours", "must be >= 0");
   Require(config.min_consensus >= 2, "min_consensus", "must be >= 2");
-  Require(config.min_gamma >= 0.0 && config.min_gamma <= 1.0, "min_gamma", "must lie in [0, 1]");
-  Require(config.min_gamma_all_scans >= 0.0 && config.min_gamma_all_scans <= 1.0,
-          "min_gamma_all_scans", "must lie in [0, 1]");
-  Require(config.min_reference_coverage >= 0.0 && config.min_reference_coverage <= 1.0,
-          "min_reference_coverage", "must lie in [0, 1]");
-  Require(config.dense_min_hit_fraction >= 0.0 && config.dense_min_hit_fraction <= 1.0,
-          "dense_min_hit_fraction", "must lie in [0, 1]");
-  Require(config.dense_max_see_through >= 0.0 && config.dense_max_see_through <= 1.0,
-          "dense_max_see_through", "must lie in [0, 1]");
-  Require(config.dense_sure_hit_fraction >= 0.0 && config.dense_sure_hit_fraction <= 1.0,
-          "dense_sure_hit_fraction", "must lie in [0, 1]");
-  Require(config.dense_sure_see_through >= 0.0 && config.dense_sure_see_through <= 1.0,
-          "dense_sure_see_through", "must lie in [0, 1]");
+  RequireFraction(config.min_gamma, "min_gamma");
+  RequireFraction(config.min_gamma_all_scans, "min_gamma_all_scans");
+  RequireFraction(config.min_reference_coverage, "min_reference_coverage");
+  RequireFraction(config.dense_min_hit_fraction, "dense_min_hit_fraction");
+  RequireFraction(config.dense_max_see_through, "dense_max_see_through");
+  RequireFraction(config.dense_sure_hit_fraction, "dense_sure_hit_fraction");
+  RequireFraction(config.dense_sure_see_through, "dense_sure_see_through");
   Require(config.double_match_m > 0.0, "double_match_m", "must be positive");
   Require(config.distinct_distance_m > 0.0, "distinct_distance_m", "must be positive");
   Require(config.distinct_angle_deg > 0.0, "distinct_angle_deg", "must be positive");
   Require(config.ambiguity_ratio > 0.0, "ambiguity_ratio", "must be positive");
-  Require(config.min_confidence >= 0.0 && config.min_confidence <= 1.0, "min_confidence",
-          "must lie in [0, 1]");
+  RequireFraction(config.min_confidence, "min_confidence");
   Require(config.confidence_consensus >= 1, "confidence_consensus", "must be >= 1");
 }
 

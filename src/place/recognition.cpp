@@ -255,11 +255,15 @@ DenseReference ReferenceOccupancy(const std::vector<Place>& places, int place_in
   return DenseReference(cells, cell_m);
 }
 
-// The dense score of a candidate when the query carries its beams and the place its occupancy.
+// The dense score of a candidate when the check is on, the query carries its beams and the place
+// its occupancy (the raster is built per candidate: not worth it when nothing reads the score).
 void ScoreDense(const Verification& v, int place_index, const std::vector<int>& neighbours,
                 const Pose2& T_ref_query, CandidateResult& result) {
   const Place& place = v.places[static_cast<std::size_t>(place_index)];
-  if (v.query.scans.empty() || place.occupancy_cells.empty()) return;
+  if (v.config.dense_min_hit_fraction <= 0.0 || v.query.scans.empty() ||
+      place.occupancy_cells.empty()) {
+    return;
+  }
   const DenseReference reference = ReferenceOccupancy(v.places, place_index, neighbours);
   if (reference.empty()) return;
   result.dense = reference.Score(T_ref_query, v.query.scans);
@@ -321,8 +325,7 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
   // Second check. Where enough of the query's beams fall in the candidate's area they veto a
   // pose that puts them off its walls or through them, and a pose they confirm beyond doubt
   // needs no gamma (sparse stable keypoints make gamma small in open halls); elsewhere gamma.
-  const bool dense_applies = config.dense_min_hit_fraction > 0.0 && result.dense_checked &&
-                             result.dense.endpoints >= kDenseMinEndpoints;
+  const bool dense_applies = result.dense_checked && result.dense.endpoints >= kDenseMinEndpoints;
   if (dense_applies && (result.dense.hit_fraction < config.dense_min_hit_fraction ||
                         result.dense.see_through_fraction > config.dense_max_see_through)) {
     return std::nullopt;

@@ -106,8 +106,8 @@ struct CandidateResult {
   int consensus = 0;
   double gamma = 0.0;
   double reference_coverage = 0.0;  // see ReferenceCoverage, with the RANSAC query keypoints
-  // The dense score, when the query has its scans and the place its occupancy, and whether it
-  // confirmed the pose beyond doubt, which passes the second check whatever gamma
+  // The dense score, when the check is on, the query has its scans and the place its occupancy,
+  // and whether it confirmed the pose beyond doubt, which passes the second check whatever gamma
   // (PlaceRecognitionConfig::dense_sure_hit_fraction).
   bool dense_checked = false;
   bool dense_sure = false;
