@@ -11,21 +11,25 @@ std::string LastPart(const std::string& name) { return name.substr(name.rfind('.
 }  // namespace
 
 std::size_t EditDistance(const std::string& a, const std::string& b) {
-  // distance[i][j]: from a's first i characters to b's first j (optimal string alignment).
-  std::vector<std::vector<std::size_t>> distance(a.size() + 1,
-                                                 std::vector<std::size_t>(b.size() + 1));
-  for (std::size_t i = 0; i <= a.size(); ++i) distance[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) distance[0][j] = j;
+  // Optimal string alignment over three rows (a's first i - 2, i - 1 and i characters against
+  // b's first j): memory grows with b only, so a long a costs time, not a table.
+  std::vector<std::size_t> two_back(b.size() + 1);
+  std::vector<std::size_t> previous(b.size() + 1);
+  std::vector<std::size_t> current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t substitution = distance[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
-      distance[i][j] = std::min({distance[i - 1][j] + 1, distance[i][j - 1] + 1, substitution});
+      const std::size_t substitution = previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, substitution});
       if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
-        distance[i][j] = std::min(distance[i][j], distance[i - 2][j - 2] + 1);
+        current[j] = std::min(current[j], two_back[j - 2] + 1);
       }
     }
+    std::swap(two_back, previous);
+    std::swap(previous, current);
   }
-  return distance[a.size()][b.size()];
+  return previous[b.size()];
 }
 
 std::vector<std::string> ClosestNames(const std::string& word,
@@ -33,10 +37,15 @@ std::vector<std::string> ClosestNames(const std::string& word,
   const std::size_t limit = std::max<std::size_t>(1, LastPart(word).size() / 4);
   std::vector<std::pair<std::size_t, std::string>> close;
   for (const std::string& candidate : candidates) {
+    const bool same_last_part = LastPart(candidate) == LastPart(word) && candidate != word;
+    // The distance is at least the difference in length: a long word (a hostile key of a
+    // megabyte) is not compared cell by cell with every name.
+    const std::size_t length_difference = word.size() > candidate.size()
+                                              ? word.size() - candidate.size()
+                                              : candidate.size() - word.size();
+    if (length_difference > limit && !same_last_part) continue;
     const std::size_t distance = EditDistance(word, candidate);
-    if (distance <= limit || (LastPart(candidate) == LastPart(word) && candidate != word)) {
-      close.emplace_back(distance, candidate);
-    }
+    if (distance <= limit || same_last_part) close.emplace_back(distance, candidate);
   }
   std::stable_sort(close.begin(), close.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -285,6 +285,17 @@ TEST(ConfigBuilder, UnknownKeysNameTheClosestKeys) {
   EXPECT_EQ(EditDistance("mpa", "map"), 1u);
   EXPECT_EQ(EditDistance("odometry.max_rang_m", "odometry.max_range_m"), 1u);
   EXPECT_EQ(EditDistance("", "abc"), 3u);
+  EXPECT_EQ(EditDistance("abc", ""), 3u);
+  EXPECT_EQ(EditDistance("abcdef", "abdcef"), 1u);
+  EXPECT_EQ(EditDistance("ca", "abc"), 3u);  // optimal string alignment: no edit of a swapped pair
+  EXPECT_EQ(EditDistance("kitten", "sitting"), 3u);
+  // A hostile key of 200 kB: no guess from a name far shorter, the right key by its last part.
+  const std::string long_section(200000, 'x');
+  std::vector<std::string> keys;
+  for (const auto& key_value : ConfigKeyValues(Config{})) keys.push_back(key_value.first);
+  EXPECT_EQ(DidYouMean(long_section, keys), "");
+  EXPECT_EQ(ClosestNames(long_section + ".max_range_m", keys),
+            (std::vector<std::string>{"odometry.max_range_m", "slam.loop_refinement.max_range_m"}));
   EXPECT_EQ(DidYouMean("mpa", {"map", "merge", "info"}), "; did you mean 'map'?");
   EXPECT_EQ(DidYouMean("zzzz", {"map", "merge", "info"}), "");
   try {
