@@ -84,6 +84,8 @@ void BindLocalizationResult(py::module_& module) {
           "T_odom_origin", [](const LocalizationResult& r) { return PoseArray(r.T_odom_origin); },
           "Odometry pose of the query's first scan (the query frame).")
       .def_readonly("scans", &LocalizationResult::scans, "Scans in the query.")
+      .def_readonly("query_id", &LocalizationResult::query_id,
+                    "Answers with the same id came from one growing query (-1: independent).")
       .def_property_readonly(
           "scan_ids", [](const LocalizationResult& r) { return VectorArray(r.scan_ids); },
           "The ids given to add_scan for the query's scans (-1 when none was given).")
@@ -162,7 +164,9 @@ void BindRelocalizer(py::module_& module) {
       .def_readonly("answer", &RelocalizationUpdate::answer,
                     "The GlobalLocalizer's answer with this scan, or None.")
       .def_readonly("confirmed", &RelocalizationUpdate::confirmed)
-      .def_readonly("contradicted", &RelocalizationUpdate::contradicted);
+      .def_readonly("contradicted", &RelocalizationUpdate::contradicted)
+      .def_readonly("self_contradicted", &RelocalizationUpdate::self_contradicted,
+                    "The answer's query named places that disagree: its answers were set aside.");
 
   py::class_<Relocalizer>(module, "Relocalizer",
                           "The GlobalLocalizer's answers turned into a fix once they agree "

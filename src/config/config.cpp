@@ -167,6 +167,9 @@ const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
     table
         .Int("max_query_scans", &C::max_query_scans, "",
              "a query submap not complete after this many scans is recognised as it stands")
+        .Double("query_every_m", &C::query_every_m, "m",
+                "also answer from the query as it stands every time the robot travelled this far "
+                "(0 = only complete queries)")
         .Nested("fix", &C::fix, FixPolicyFields());
     return table;
   }();

@@ -32,6 +32,9 @@ void Validate(const LocalizerConfig& config) {
   if (config.max_query_scans < 1) {
     throw std::invalid_argument("LocalizerConfig.max_query_scans must be >= 1");
   }
+  if (!(config.query_every_m >= 0.0) || !std::isfinite(config.query_every_m)) {
+    throw std::invalid_argument("LocalizerConfig.query_every_m must be finite and >= 0");
+  }
   Validate(config.fix);
 }
 
@@ -95,12 +98,20 @@ std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan
                                                            std::vector<Keypoint> keypoints,
                                                            int scan_id) {
   const bool complete = builder_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id);
-  if (!complete && static_cast<int>(builder_.size()) < config_.max_query_scans) {
-    return std::nullopt;
+  if (last_T_odom_robot_) {
+    path_since_answer_m_ += TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
   }
-  LocalizationResult result = Localize();
-  Reset();
-  return result;
+  last_T_odom_robot_ = T_odom_robot;
+  if (complete || static_cast<int>(builder_.size()) >= config_.max_query_scans) {
+    LocalizationResult result = Localize();
+    Reset();
+    return result;
+  }
+  if (config_.query_every_m > 0.0 && path_since_answer_m_ >= config_.query_every_m) {
+    path_since_answer_m_ = 0.0;
+    return Localize();
+  }
+  return std::nullopt;
 }
 
 std::optional<LocalizationResult> GlobalLocalizer::LocalizeNow() const {
@@ -108,7 +119,12 @@ std::optional<LocalizationResult> GlobalLocalizer::LocalizeNow() const {
   return Localize();
 }
 
-void GlobalLocalizer::Reset() { builder_.Reset(); }
+void GlobalLocalizer::Reset() {
+  builder_.Reset();
+  path_since_answer_m_ = 0.0;
+  last_T_odom_robot_.reset();
+  ++query_id_;
+}
 
 LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
@@ -123,6 +139,7 @@ LocalizationResult GlobalLocalizer::Localize() const {
   result.scans = builder_.size();
   result.scan_ids = std::move(scan_ids);
   result.T_odom_origin = builder_.pose(0);
+  result.query_id = query_id_;
   return result;
 }
 

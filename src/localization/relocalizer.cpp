@@ -54,6 +54,7 @@ FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(polic
 void FixFilter::Reset() {
   status_ = FixStatus::kSearching;
   last_T_odom_robot_.reset();
+  self_contradicted_query_ = -1;
   odometry_m_ = 0.0;
   hypotheses_.clear();
   challengers_.clear();
@@ -72,9 +73,12 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
   last_T_odom_robot_ = T_odom_robot;
 
   RelocalizationUpdate update;
-  if (answer && answer->found) {
-    const Hypothesis hypothesis{answer->T_world_odom, answer->confidence, odometry_m_,
-                                answer->match.estimated_pose_covariance, T_odom_robot};
+  if (answer && !OwnQueryAllows(*answer, T_odom_robot)) {
+    update.self_contradicted = true;
+  } else if (answer && answer->found) {
+    const Hypothesis hypothesis{answer->T_world_odom, answer->confidence,
+                                odometry_m_,          answer->match.estimated_pose_covariance,
+                                T_odom_robot,         answer->query_id};
     if (status_ == FixStatus::kFixed) {
       Track(hypothesis, T_odom_robot, update);
     } else {
@@ -202,21 +206,46 @@ void FixFilter::Confirm(const Hypothesis& answer, const Pose2& T_odom_robot) {
   challengers_.clear();
 }
 
+bool FixFilter::Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const {
+  const Pose2 difference = Between(b.T_world_odom * T_odom_robot, a.T_world_odom * T_odom_robot);
+  const double travelled_m = std::abs(a.odometry_m - b.odometry_m);
+  const double tolerance_m = policy_.agree_m + policy_.agree_per_m * travelled_m;
+  return TranslationNorm(difference) <= tolerance_m &&
+         std::abs(difference.theta) <= policy_.agree_deg * kRadPerDeg;
+}
+
 std::vector<FixFilter::Hypothesis> FixFilter::Agreeing(const std::vector<Hypothesis>& pool,
                                                        const Hypothesis& hypothesis,
                                                        const Pose2& T_odom_robot) const {
-  const Pose2 T_world_robot = hypothesis.T_world_odom * T_odom_robot;
   std::vector<Hypothesis> agreeing;
   for (const Hypothesis& other : pool) {
-    const Pose2 difference = Between(other.T_world_odom * T_odom_robot, T_world_robot);
-    const double travelled_m = std::abs(hypothesis.odometry_m - other.odometry_m);
-    const double tolerance_m = policy_.agree_m + policy_.agree_per_m * travelled_m;
-    if (TranslationNorm(difference) <= tolerance_m &&
-        std::abs(difference.theta) <= policy_.agree_deg * kRadPerDeg) {
-      agreeing.push_back(other);
-    }
+    if (hypothesis.query_id >= 0 && other.query_id == hypothesis.query_id) continue;
+    if (Agree(hypothesis, other, T_odom_robot)) agreeing.push_back(other);
   }
   return agreeing;
+}
+
+// A query that grows (LocalizerConfig::query_every_m) answers several times; its newest answer,
+// from the most scans, replaces its older ones as evidence (an ambiguous one withdraws them). A
+// query whose accepted answers name places that disagree is itself ambiguous: two look-alike
+// rooms seen from part of one of them. Nothing it says counts any more.
+bool FixFilter::OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_odom_robot) {
+  if (answer.query_id < 0) return true;
+  if (answer.query_id == self_contradicted_query_) return false;
+  const Hypothesis latest{answer.T_world_odom, answer.confidence, odometry_m_, {},
+                          T_odom_robot,        answer.query_id};
+  bool contradicted = false;
+  for (std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
+    for (const Hypothesis& earlier : *pool) {
+      if (earlier.query_id != answer.query_id) continue;
+      if (answer.found && !Agree(latest, earlier, T_odom_robot)) contradicted = true;
+    }
+    pool->erase(std::remove_if(pool->begin(), pool->end(),
+                               [&](const Hypothesis& h) { return h.query_id == answer.query_id; }),
+                pool->end());
+  }
+  if (contradicted) self_contradicted_query_ = answer.query_id;
+  return !contradicted;
 }
 
 void FixFilter::Forget(std::vector<Hypothesis>& pool) const {

@@ -44,6 +44,35 @@ TEST(FixFilter, OneAnswerIsNotAFixTwoThatAgreeAre) {
   EXPECT_FALSE(update.new_fix);
 }
 
+// Answers of one growing query (LocalizerConfig::query_every_m) share scans: a wrong pose they
+// agree on is one mistake seen twice, so only an answer of another query confirms it, while
+// searching and when challenging a fix.
+LocalizationResult AnswerOfQuery(const Pose2& T_world_odom, long long query_id,
+                                 double confidence = 0.5) {
+  LocalizationResult answer = Answer(T_world_odom, confidence);
+  answer.query_id = query_id;
+  return answer;
+}
+
+TEST(FixFilter, AnswersOfOneQueryDoNotConfirmEachOther) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 7), Odometry(0));
+  EXPECT_EQ(filter.Update(AnswerOfQuery(kTrue, 7), Odometry(4)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(AnswerOfQuery(kTrue, 7), Odometry(8)).status, FixStatus::kSearching);
+  const RelocalizationUpdate update = filter.Update(AnswerOfQuery(kTrue, 8), Odometry(12));
+  EXPECT_EQ(update.status, FixStatus::kFixed);
+  EXPECT_TRUE(update.new_fix);
+
+  // Two challengers of one query do not overturn the fix; a third of another query does.
+  EXPECT_TRUE(filter.Update(AnswerOfQuery(kWrong, 9), Odometry(13)).contradicted);
+  EXPECT_EQ(filter.Update(AnswerOfQuery(kWrong, 9), Odometry(14)).status, FixStatus::kFixed);
+  EXPECT_FALSE(filter.Update(AnswerOfQuery(kWrong, 9), Odometry(15)).new_fix);
+  const RelocalizationUpdate overturned = filter.Update(AnswerOfQuery(kWrong, 10), Odometry(16));
+  EXPECT_TRUE(overturned.lost);
+  EXPECT_TRUE(overturned.new_fix);
+  EXPECT_NEAR(overturned.T_world_odom.x, kWrong.x, 1e-9);
+}
+
 TEST(FixFilter, AnswersThatDisagreeGiveNoFix) {
   FixFilter filter;
   filter.Update(Answer(kTrue), Odometry(0));

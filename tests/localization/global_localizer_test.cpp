@@ -51,7 +51,9 @@ PlaceMatch BatchAnswer(const Bundled& b, const PlaceRecognizer& recognizer, int 
 
 TEST(GlobalLocalizer, StreamingGivesTheBatchAnswerOnEveryQueryOfTheBundledLog) {
   const Bundled& b = BundledLog();
-  GlobalLocalizer localizer(b.map);
+  LocalizerConfig complete_queries_only;
+  complete_queries_only.query_every_m = 0.0;
+  GlobalLocalizer localizer(b.map, complete_queries_only);
   localizer.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
     return IsSelfMatch(SelfMatchRule::kSameScans, SortedScans(query_scans), place.scan_indices);
   });
@@ -204,6 +206,56 @@ TEST(GlobalLocalizer, MaxQueryScansClosesAQueryThatNeverCompletes) {
   EXPECT_EQ(result->scans, 3u);
   EXPECT_EQ(localizer.buffered_scans(), 0u);
   config.max_query_scans = 0;
+  EXPECT_THROW(GlobalLocalizer(b.map, config), std::invalid_argument);
+}
+
+// query_every_m: the query as it stands answers every time the robot has travelled that far,
+// growing until it completes; its answers share an id, the next query's differ. Off, only
+// complete queries answer.
+TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
+  const Bundled& b = BundledLog();
+  LocalizerConfig config;
+  config.query_every_m = 1.0;
+  GlobalLocalizer every_metre(b.map, config);
+  config.query_every_m = 0.0;
+  GlobalLocalizer complete_only(b.map, config);
+  std::vector<LocalizationResult> answers;
+  std::vector<std::size_t> complete_sizes;
+  double path_m = 0.0;
+  std::vector<double> answer_paths_m;
+  for (std::size_t k = 100; k < 260; ++k) {
+    if (k > 100) path_m += TranslationNorm(Between(b.inputs.poses[k - 1], b.inputs.poses[k]));
+    const auto& scan = b.inputs.log.scans[k];
+    if (auto answer = every_metre.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k])) {
+      answers.push_back(*answer);
+      answer_paths_m.push_back(path_m);
+    }
+    if (auto answer = complete_only.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k])) {
+      complete_sizes.push_back(answer->scans);
+    }
+  }
+  ASSERT_GE(complete_sizes.size(), 2u);
+  ASSERT_GT(answers.size(), complete_sizes.size());
+  // Every complete query is among the answers, with the answers before it growing within it.
+  std::size_t completed = 0;
+  for (std::size_t i = 0; i < answers.size(); ++i) {
+    const bool last_of_query =
+        i + 1 == answers.size() || answers[i + 1].query_id != answers[i].query_id;
+    if (i > 0 && answers[i].query_id == answers[i - 1].query_id) {
+      EXPECT_GT(answers[i].scans, answers[i - 1].scans) << i;
+      // Answers before completion come a metre apart; completion answers at once.
+      if (!last_of_query) {
+        EXPECT_GE(answer_paths_m[i] - answer_paths_m[i - 1], 1.0 - 1e-9) << i;
+      }
+    }
+    if (last_of_query && completed < complete_sizes.size() && i + 1 < answers.size()) {
+      EXPECT_EQ(answers[i].scans, complete_sizes[completed]) << i;
+      EXPECT_GT(answers[i + 1].query_id, answers[i].query_id) << i;
+      ++completed;
+    }
+  }
+  EXPECT_GE(completed, 1u);
+  config.query_every_m = -1.0;
   EXPECT_THROW(GlobalLocalizer(b.map, config), std::invalid_argument);
 }
 

@@ -60,6 +60,11 @@ struct LocalizerConfig {
   // A query submap that is not complete after this many scans is recognised as it stands (when
   // the map's own max_scans_per_submap is smaller, that one closes it first). Bounds memory.
   int max_query_scans = 300;
+  // Also recognise the query as it stands every time the robot has travelled this far since
+  // the last answer (odometry path; 0 = only complete queries): an answer from the scans the
+  // robot has now, where submaps take long to complete (scans far apart, open halls). The query
+  // keeps growing; completion resets it.
+  double query_every_m = 1.0;
   FixPolicy fix;  // the Relocalizer's
 };
 
@@ -80,7 +85,10 @@ struct LocalizationResult {
   std::size_t scans = 0;      // scans in the query
   std::vector<int> scan_ids;  // their ids as given to AddScan (-1 when none was given)
   Pose2 T_odom_origin;        // odometry pose of the query's first scan (the query frame)
-  PlaceMatch match;           // all the details of the recognition
+  // Answers with the same id came from one query (LocalizerConfig::query_every_m) and share
+  // scans, so they are not independent evidence; -1: independent of every other answer.
+  long long query_id = -1;
+  PlaceMatch match;  // all the details of the recognition
 };
 
 /// Which map places a query must not be matched with, given the ids of the query's scans (the
@@ -100,7 +108,8 @@ class GlobalLocalizer {
                                   const FlirtConfig& features = {});
 
   /// Adds the next scan with the robot's pose in its odometry frame. Returns an answer when the
-  /// query submap completes with this scan (then the next scan starts a new query), else nullopt.
+  /// query submap completes with this scan (then the next scan starts a new query) or when
+  /// the robot travelled LocalizerConfig::query_every_m since the last answer, else nullopt.
   std::optional<LocalizationResult> AddScan(const LaserScan& scan, const Pose2& T_odom_robot);
 
   /// The same with the scan's FLIRT keypoints already extracted (laser frame) and the caller's
@@ -132,6 +141,9 @@ class GlobalLocalizer {
   std::shared_ptr<const PlaceRecognizer> recognizer_;
   std::shared_ptr<const FlirtExtractor> extractor_;
   SubmapQueryBuilder builder_;
+  double path_since_answer_m_ = 0.0;
+  std::optional<Pose2> last_T_odom_robot_;
+  long long query_id_ = 0;  // counts the queries begun
   QueryExclusion exclusion_;
 };
 

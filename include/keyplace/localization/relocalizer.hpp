@@ -70,6 +70,9 @@ struct RelocalizationUpdate {
   // The answer was accepted and agreed with the fix (confirmation) or contradicted it.
   bool confirmed = false;
   bool contradicted = false;
+  // The answer came from a query whose accepted answers disagree with each other (it sees a
+  // place that looks like another); it and the query's other answers were set aside.
+  bool self_contradicted = false;
 };
 
 /// The temporal part alone: turns a stream of answers (one per scan, most of them none) into
@@ -95,12 +98,19 @@ class FixFilter {
     // Covariance of the robot's pose in the map at T_odom_robot, from the match.
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     Pose2 T_odom_robot;
+    long long query_id = -1;  // LocalizationResult::query_id
   };
 
   void Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
               RelocalizationUpdate& update);
   void Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot, RelocalizationUpdate& update);
-  // The hypotheses in `pool` that agree with `hypothesis` at the robot's current pose.
+  // Whether two hypotheses name the same robot pose now, within the policy's tolerances.
+  bool Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const;
+  // Drops the earlier answers of `answer`'s query from the pools; false when the query
+  // contradicts itself (then its answers no longer count).
+  bool OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_odom_robot);
+  // The hypotheses in `pool` that agree with `hypothesis` at the robot's current pose and come
+  // from another query (answers of one query share its scans: their agreement proves nothing).
   std::vector<Hypothesis> Agreeing(const std::vector<Hypothesis>& pool,
                                    const Hypothesis& hypothesis, const Pose2& T_odom_robot) const;
   void Forget(std::vector<Hypothesis>& pool) const;  // drops those older than window_m
@@ -119,7 +129,8 @@ class FixFilter {
   double odometry_m_ = 0.0;
   std::vector<Hypothesis> hypotheses_;   // accepted answers while searching
   std::vector<Hypothesis> challengers_;  // accepted answers contradicting the fix
-  Pose2 T_world_odom_;                   // the fix
+  long long self_contradicted_query_ = -1;
+  Pose2 T_world_odom_;  // the fix
   double fix_confidence_ = 0.0;
   double fix_variance_m2_ = 0.0;  // of the fix's position at its last confirmation
   double confirmed_at_m_ = 0.0;   // odometry distance of the last confirmation
