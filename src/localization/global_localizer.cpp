@@ -1,5 +1,6 @@
 #include "keyplace/localization/global_localizer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -99,7 +100,9 @@ std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan
                                                            int scan_id) {
   const bool complete = builder_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id);
   if (last_T_odom_robot_) {
-    path_since_answer_m_ += TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
+    const double step_m = TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
+    path_since_answer_m_ += step_m;
+    query_path_m_ += step_m;
   }
   last_T_odom_robot_ = T_odom_robot;
   if (complete || static_cast<int>(builder_.size()) >= config_.max_query_scans) {
@@ -107,7 +110,12 @@ std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan
     Reset();
     return result;
   }
-  if (config_.query_every_m > 0.0 && path_since_answer_m_ >= config_.query_every_m) {
+  // An answer of a long query says something new only when a good part of it is new: the next
+  // one waits for half the path the query had at the last (at least query_every_m), so a query
+  // of length L answers O(log L) times, not L / query_every_m.
+  const double next_answer_m =
+      std::max(config_.query_every_m, 0.5 * (query_path_m_ - path_since_answer_m_));
+  if (config_.query_every_m > 0.0 && path_since_answer_m_ >= next_answer_m) {
     path_since_answer_m_ = 0.0;
     return Localize();
   }
@@ -122,6 +130,7 @@ std::optional<LocalizationResult> GlobalLocalizer::LocalizeNow() const {
 void GlobalLocalizer::Reset() {
   builder_.Reset();
   path_since_answer_m_ = 0.0;
+  query_path_m_ = 0.0;
   last_T_odom_robot_.reset();
   ++query_id_;
 }

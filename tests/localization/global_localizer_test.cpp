@@ -209,9 +209,9 @@ TEST(GlobalLocalizer, MaxQueryScansClosesAQueryThatNeverCompletes) {
   EXPECT_THROW(GlobalLocalizer(b.map, config), std::invalid_argument);
 }
 
-// query_every_m: the query as it stands answers every time the robot has travelled that far,
-// growing until it completes; its answers share an id, the next query's differ. Off, only
-// complete queries answer.
+// query_every_m: the query as it stands answers every time the robot has travelled that far
+// (or half the query's path at its last answer, when longer), growing until it completes; its
+// answers share an id, the next query's differ. Off, only complete queries answer.
 TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
   const Bundled& b = BundledLog();
   LocalizerConfig config;
@@ -222,30 +222,42 @@ TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
   std::vector<LocalizationResult> answers;
   std::vector<std::size_t> complete_sizes;
   double path_m = 0.0;
+  double query_start_m = 0.0;  // path at the query's first scan
+  bool query_starts = true;
   std::vector<double> answer_paths_m;
+  std::vector<double> query_paths_m;  // the query's own path at each answer
   for (std::size_t k = 100; k < 260; ++k) {
     if (k > 100) path_m += TranslationNorm(Between(b.inputs.poses[k - 1], b.inputs.poses[k]));
+    if (query_starts) query_start_m = path_m;
     const auto& scan = b.inputs.log.scans[k];
-    if (auto answer = every_metre.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k])) {
+    auto answer = every_metre.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k]);
+    query_starts = every_metre.buffered_scans() == 0;
+    if (answer) {
       answers.push_back(*answer);
       answer_paths_m.push_back(path_m);
+      query_paths_m.push_back(path_m - query_start_m);
     }
-    if (auto answer = complete_only.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k])) {
-      complete_sizes.push_back(answer->scans);
+    if (auto complete = complete_only.AddScan(scan, b.inputs.poses[k], b.inputs.keypoints[k])) {
+      complete_sizes.push_back(complete->scans);
     }
   }
   ASSERT_GE(complete_sizes.size(), 2u);
   ASSERT_GT(answers.size(), complete_sizes.size());
   // Every complete query is among the answers, with the answers before it growing within it.
   std::size_t completed = 0;
+  int spaced_by_length = 0;
   for (std::size_t i = 0; i < answers.size(); ++i) {
     const bool last_of_query =
         i + 1 == answers.size() || answers[i + 1].query_id != answers[i].query_id;
     if (i > 0 && answers[i].query_id == answers[i - 1].query_id) {
       EXPECT_GT(answers[i].scans, answers[i - 1].scans) << i;
-      // Answers before completion come a metre apart; completion answers at once.
+      // Answers before completion come a metre apart, or half the query's path at the last
+      // answer when that is longer; completion answers at once.
       if (!last_of_query) {
-        EXPECT_GE(answer_paths_m[i] - answer_paths_m[i - 1], 1.0 - 1e-9) << i;
+        const double gap_m = std::max(1.0, 0.5 * query_paths_m[i - 1]);
+        EXPECT_GE(answer_paths_m[i] - answer_paths_m[i - 1], gap_m - 1e-9) << i;
+        EXPECT_LT(answer_paths_m[i] - answer_paths_m[i - 1], gap_m + 1.0) << i;
+        if (gap_m > 1.0) ++spaced_by_length;
       }
     }
     if (last_of_query && completed < complete_sizes.size() && i + 1 < answers.size()) {
@@ -255,6 +267,7 @@ TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
     }
   }
   EXPECT_GE(completed, 1u);
+  EXPECT_GT(spaced_by_length, 0);
   config.query_every_m = -1.0;
   EXPECT_THROW(GlobalLocalizer(b.map, config), std::invalid_argument);
 }

@@ -142,6 +142,7 @@ class GlobalLocalizer {
   std::shared_ptr<const FlirtExtractor> extractor_;
   SubmapQueryBuilder builder_;
   double path_since_answer_m_ = 0.0;
+  double query_path_m_ = 0.0;  // odometry path of the query being built
   std::optional<Pose2> last_T_odom_robot_;
   long long query_id_ = 0;  // counts the queries begun
   QueryExclusion exclusion_;
