@@ -31,7 +31,8 @@ SANITIZE_SKIP_TESTS := GlobalLocalizer.StreamingGivesTheBatchAnswerOnEveryQueryO
   OnlineSlam.AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld \
   ParallelRecognition.SameAnswerAtOneTwoAndFourThreadsOnTheBundledLog \
   RecognitionThresholds.EachAnswerIsThatOfARecognizerWithThoseThresholds \
-  PlaceDatabase.AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog
+  PlaceDatabase.AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundledLog \
+  ParallelQueries.RecordsAndSummaryAreTheSameAtOneAndTwoThreads
 empty :=
 space := $(empty) $(empty)
 SANITIZE_SKIP := ^($(subst $(space),|,$(strip $(SANITIZE_SKIP_TESTS))))$$

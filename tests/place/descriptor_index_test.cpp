@@ -118,12 +118,10 @@ TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnRandomDescriptors) 
   EXPECT_GT(check.max_ratio, 1.99);
 }
 
-// The bundled log, its map (default mapping) and its queries (Algorithm 4, 500 starts, default
-// query keypoints), built once.
+// The bundled log and its map (default mapping), built once.
 struct Bundled {
   LogInputs inputs;
   GlobalMap map;
-  std::vector<LocalizationQuery> queries;
   std::vector<BetaGridDescriptor> descriptors;  // of every keypoint of every scan
 };
 
@@ -133,15 +131,24 @@ const Bundled& BundledLog() {
     const testing::BundledMap& log = testing::BundledFr079();
     b.inputs = log.inputs;
     b.map = log.map;
-    const GroundTruth& truth = log.truth;
-    b.queries = BuildSubmapQueries(b.inputs, truth, b.map.config, QueryStarts(truth, 500),
-                                   PlaceRecognitionConfig{}.query_keypoints);
     for (const auto& scan : b.inputs.keypoints) {
       for (const Keypoint& keypoint : scan) b.descriptors.push_back(keypoint.descriptor);
     }
     return b;
   }();
   return bundled;
+}
+
+// Every step-th of the bundled log's queries (Algorithm 4, 500 starts, default query keypoints):
+// built alone, each is the query built among all of them (queries cost seconds under the
+// sanitizers; most tests need a few).
+std::vector<LocalizationQuery> QueriesEvery(std::size_t step) {
+  const testing::BundledMap& log = testing::BundledFr079();
+  const std::vector<int> all = QueryStarts(log.truth, 500);
+  std::vector<int> starts;
+  for (std::size_t i = 0; i < all.size(); i += step) starts.push_back(all[i]);
+  return BuildSubmapQueries(log.inputs, log.truth, log.map.config, starts,
+                            PlaceRecognitionConfig{}.query_keypoints);
 }
 
 TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnTheBundledLog) {
@@ -400,31 +407,32 @@ TEST(DescriptorIndex, RecognizerGivesTheSameMatchesOnRandomPlaces) {
 // query (the exhaustive answers take most of this test's time).
 TEST(DescriptorIndex, SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog) {
   const Bundled& b = BundledLog();
-  ASSERT_GT(b.queries.size(), 480u);
+  const std::vector<LocalizationQuery> queries = QueriesEvery(1);
+  ASSERT_GT(queries.size(), 480u);
   const PlaceRecognitionConfig base;  // default preset
   PlaceRecognitionConfig none = base;
   none.descriptor_index = Index::kNone;
   const std::vector<LocalizationRecord> expected = EvaluateQueries(
-      b.queries, PlaceRecognizer(PlacesFromMap(b.map), none), SelfMatchRule::kSameScans);
+      queries, PlaceRecognizer(PlacesFromMap(b.map), none), SelfMatchRule::kSameScans);
   std::vector<LocalizationQuery> every_fifth;
-  for (std::size_t i = 0; i < b.queries.size(); i += 5) every_fifth.push_back(b.queries[i]);
+  for (std::size_t i = 0; i < queries.size(); i += 5) every_fifth.push_back(queries[i]);
   int found = 0;
   for (Index kind : {Index::kDense, Index::kKdTree}) {
     PlaceRecognitionConfig config = base;
     config.descriptor_index = kind;
     const bool all = kind == Index::kDense;
     const std::vector<LocalizationRecord> records =
-        EvaluateQueries(all ? b.queries : every_fifth,
-                        PlaceRecognizer(PlacesFromMap(b.map), config), SelfMatchRule::kSameScans);
+        EvaluateQueries(all ? queries : every_fifth, PlaceRecognizer(PlacesFromMap(b.map), config),
+                        SelfMatchRule::kSameScans);
     ASSERT_EQ(records.size(), all ? expected.size() : every_fifth.size());
     for (std::size_t i = 0; i < records.size(); ++i) {
       const std::size_t e = all ? i : 5 * i;
       testing::ExpectSameMatch(records[i].match, expected[e].match,
-                               "start " + std::to_string(b.queries[e].start_scan));
+                               "start " + std::to_string(queries[e].start_scan));
       if (all) found += records[i].match.found ? 1 : 0;
     }
   }
-  EXPECT_GT(found, static_cast<int>(b.queries.size()) * 9 / 10);  // recall ~0.98
+  EXPECT_GT(found, static_cast<int>(queries.size()) * 9 / 10);  // recall ~0.98
 }
 
 // Incremental place database: a recognizer grown place by place (from empty), then shrunk and
@@ -470,10 +478,7 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
                              : kind == Index::kKdTree ? "kdtree"
                                                       : "none";
     // Every 20th query (every 100th for the exhaustive search, which dominates this test's time).
-    std::vector<LocalizationQuery> queries;
-    for (std::size_t i = 0; i < b.queries.size(); i += kind == Index::kNone ? 100 : 20) {
-      queries.push_back(b.queries[i]);
-    }
+    const std::vector<LocalizationQuery> queries = QueriesEvery(kind == Index::kNone ? 100 : 20);
     PlaceRecognitionConfig config;  // default preset
     config.descriptor_index = kind;
 
@@ -531,8 +536,7 @@ TEST(PlaceDatabase, CopiesDoNotShareChangesAndBadInputThrows) {
   for (auto it = all.end() - 5; it != all.end(); ++it) copy.AddPlace(*it);
   ASSERT_TRUE(copy.RemovePlace(all.front().id));
   EXPECT_EQ(original.places().size(), all.size() - 5);
-  std::vector<LocalizationQuery> queries;
-  for (std::size_t i = 0; i < b.queries.size(); i += 10) queries.push_back(b.queries[i]);
+  const std::vector<LocalizationQuery> queries = QueriesEvery(10);
   ExpectSameAnswers(queries, original, std::vector<Place>(all.begin(), all.end() - 5), "original");
   ExpectSameAnswers(queries, copy, std::vector<Place>(all.begin() + 1, all.end()), "copy");
 
