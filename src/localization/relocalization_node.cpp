@@ -321,10 +321,7 @@ void RelocalizationNode::Publish(const RelocalizationUpdate& update, double stam
   }
   if (update.lost) {
     ++status_.losses;
-    output.events.push_back(
-        {NodeEventLevel::kWarning,
-         at + (update.off_map ? ": fix lost (the scans no longer fit the map there)"
-                              : ": fix lost")});
+    output.events.push_back({NodeEventLevel::kWarning, at + ": fix lost"});
   }
   if (update.status != FixStatus::kFixed) {
     status_.pose.reset();
