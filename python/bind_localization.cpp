@@ -166,10 +166,7 @@ void BindRelocalizer(py::module_& module) {
       .def_readonly("confirmed", &RelocalizationUpdate::confirmed)
       .def_readonly("contradicted", &RelocalizationUpdate::contradicted)
       .def_readonly("self_contradicted", &RelocalizationUpdate::self_contradicted,
-                    "The answer's query named places that disagree: its answers were set aside.")
-      .def_readonly("off_map", &RelocalizationUpdate::off_map,
-                    "The fix was given up with this scan: the latest scans, put into the map by "
-                    "it, no longer fit the map's walls.");
+                    "The answer's query named places that disagree: its answers were set aside.");
 
   py::class_<Relocalizer>(module, "Relocalizer",
                           "The GlobalLocalizer's answers turned into a fix once they agree "

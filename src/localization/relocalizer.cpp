@@ -35,29 +35,18 @@ Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
     : localizer_(map, config, features), filter_(config.fix) {}
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
-  const TrackFit fit = CheckTrack(scan, T_odom_robot);
-  return filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot, fit);
+  return filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
 }
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
-  const TrackFit fit = CheckTrack(scan, T_odom_robot);
   return filter_.Update(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id),
-                        T_odom_robot, fit);
-}
-
-// The track is checked only while there is one, with the fix as of the previous scan.
-TrackFit Relocalizer::CheckTrack(const LaserScan& scan, const Pose2& T_odom_robot) {
-  track_.AddScan(scan, T_odom_robot);
-  if (filter_.status() != FixStatus::kFixed) return TrackFit::kUnknown;
-  return track_.Check(localizer_.recognizer().places(), localizer_.recognizer().config(),
-                      filter_.T_world_odom());
+                        T_odom_robot);
 }
 
 void Relocalizer::Reset() {
   localizer_.Reset();
   filter_.Reset();
-  track_.Reset();
 }
 
 FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(policy_); }
@@ -66,7 +55,6 @@ void FixFilter::Reset() {
   status_ = FixStatus::kSearching;
   last_T_odom_robot_.reset();
   self_contradicted_query_ = -1;
-  misfits_ = 0;
   odometry_m_ = 0.0;
   hypotheses_.clear();
   challengers_.clear();
@@ -78,21 +66,13 @@ void FixFilter::Reset() {
 }
 
 RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
-                                       const Pose2& T_odom_robot, TrackFit fit) {
+                                       const Pose2& T_odom_robot) {
   if (last_T_odom_robot_) {
     odometry_m_ += TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
   }
   last_T_odom_robot_ = T_odom_robot;
 
   RelocalizationUpdate update;
-  if (status_ == FixStatus::kFixed && fit != TrackFit::kUnknown) {
-    // As many independent refusals unmake a fix as independent answers make one.
-    misfits_ = fit == TrackFit::kMisfit ? misfits_ + 1 : 0;
-    if (misfits_ >= policy_.confirmations) {
-      DeclareLost(update);
-      update.off_map = true;
-    }
-  }
   if (answer && !OwnQueryAllows(*answer, T_odom_robot)) {
     update.self_contradicted = true;
   } else if (answer && answer->found) {
@@ -289,14 +269,12 @@ void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypoth
   confirmed_at_m_ = odometry_m_;
   hypotheses_.clear();
   challengers_.clear();
-  misfits_ = 0;
   update.new_fix = true;
 }
 
 void FixFilter::DeclareLost(RelocalizationUpdate& update) {
   status_ = FixStatus::kLost;
   fix_confidence_ = 0.0;
-  misfits_ = 0;
   hypotheses_.clear();
   challengers_.clear();
   update.lost = true;

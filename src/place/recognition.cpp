@@ -68,6 +68,8 @@ struct Candidate {
 // verified in parallel (a RANSAC each, grain 1).
 constexpr std::size_t kPlacesPerTask = 16;
 constexpr std::size_t kRankedCandidatesPerTask = 4;
+// Fewest query endpoints in the reference's area for a dense score to count.
+constexpr int kDenseMinEndpoints = 50;
 
 // The query keypoints paired and verified by RANSAC: the stable ones, or those of every scan
 // merged (kAllScans; the gamma check uses the stable ones either way).
@@ -505,19 +507,6 @@ void CheckThresholds(const std::vector<RecognitionThresholds>& thresholds) {
 }
 
 }  // namespace
-
-DenseReference PlaceOccupancy(const std::vector<Place>& places, int place_index,
-                              const std::vector<int>& others) {
-  for (const int index : others) {
-    if (index < 0 || static_cast<std::size_t>(index) >= places.size()) {
-      throw std::out_of_range("PlaceOccupancy: no place " + std::to_string(index));
-    }
-  }
-  if (place_index < 0 || static_cast<std::size_t>(place_index) >= places.size()) {
-    throw std::out_of_range("PlaceOccupancy: no place " + std::to_string(place_index));
-  }
-  return ReferenceOccupancy(places, place_index, others);
-}
 
 PlaceMatch PlaceRecognizer::Recognize(const PlaceQuery& query,
                                       const PlaceExclusion& exclude) const {

@@ -28,7 +28,6 @@
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/localization/global_localizer.hpp"
-#include "keyplace/localization/track_check.hpp"
 #include "keyplace/mapping/global_map.hpp"
 
 namespace keyplace {
@@ -74,10 +73,6 @@ struct RelocalizationUpdate {
   // The answer came from a query whose accepted answers disagree with each other (it sees a
   // place that looks like another); it and the query's other answers were set aside.
   bool self_contradicted = false;
-  // The fix was given up with this scan (lost) because the latest scans, put into the map by it,
-  // no longer fit the map: twice in a row, on disjoint scans, the dense check that vets answers
-  // refused them (TrackCheck). Odometry failed, or the fix was wrong.
-  bool off_map = false;
 };
 
 /// The temporal part alone: turns a stream of answers (one per scan, most of them none) into
@@ -88,16 +83,11 @@ class FixFilter {
   /// Throws std::invalid_argument for an invalid policy (naming the field).
   explicit FixFilter(const FixPolicy& policy = {});
 
-  /// The next scan: its odometry pose, the answer that came with it, if any, and whether the
-  /// latest scans fit the map at the fix (TrackCheck; policy_.confirmations misfits in a row, with
-  /// no fit between them, give the fix up).
-  RelocalizationUpdate Update(std::optional<LocalizationResult> answer, const Pose2& T_odom_robot,
-                              TrackFit fit = TrackFit::kUnknown);
+  /// The next scan: its odometry pose and the answer that came with it, if any.
+  RelocalizationUpdate Update(std::optional<LocalizationResult> answer, const Pose2& T_odom_robot);
 
   void Reset();
   FixStatus status() const { return status_; }
-  /// The fix (map <- odometry) when status() is kFixed.
-  const Pose2& T_world_odom() const { return T_world_odom_; }
 
  private:
   // An accepted answer, kept as a hypothesis of T_world_odom.
@@ -140,7 +130,6 @@ class FixFilter {
   std::vector<Hypothesis> hypotheses_;   // accepted answers while searching
   std::vector<Hypothesis> challengers_;  // accepted answers contradicting the fix
   long long self_contradicted_query_ = -1;
-  int misfits_ = 0;     // TrackFit::kMisfit verdicts in a row on the fix
   Pose2 T_world_odom_;  // the fix
   double fix_confidence_ = 0.0;
   double fix_variance_m2_ = 0.0;  // of the fix's position at its last confirmation
@@ -175,11 +164,8 @@ class Relocalizer {
   const GlobalLocalizer& localizer() const { return localizer_; }
 
  private:
-  TrackFit CheckTrack(const LaserScan& scan, const Pose2& T_odom_robot);
-
   GlobalLocalizer localizer_;
   FixFilter filter_;
-  TrackCheck track_;
 };
 
 }  // namespace keyplace

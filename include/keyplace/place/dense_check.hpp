@@ -59,8 +59,6 @@ constexpr double kDenseHitDistanceM = 0.2;
 // this far short of its own endpoint saw through it.
 constexpr double kDenseSeeThroughMarginM = 0.4;
 constexpr double kDenseWallCrossingM = 0.35;
-// Fewest query endpoints in the reference's area for a dense score to count.
-constexpr int kDenseMinEndpoints = 50;
 
 /// The occupied cells of a reference (cell indices of `cell_size_m`, in the reference frame)
 /// rasterized once with their hit neighbourhood, scored against any number of poses.

@@ -37,12 +37,6 @@ struct Place {
 /// One place per submap, in map order (keypoints in the submap frame, T_world_place = P[0]).
 std::vector<Place> PlacesFromMap(const GlobalMap& map);
 
-/// The occupancy of places[place_index] and of places[others], in the frame of the former (what
-/// the dense check of a candidate scores against, with its map neighbours as `others`). Empty
-/// when none of them carries occupancy cells. Throws std::out_of_range for an index outside.
-DenseReference PlaceOccupancy(const std::vector<Place>& places, int place_index,
-                              const std::vector<int>& others);
-
 /// The keypoints of the current submap S_c in its own frame (P_c[0]) and p_c: the pose to
 /// estimate, relative to P_c[0] (its last scan in the paper).
 struct PlaceQuery {
