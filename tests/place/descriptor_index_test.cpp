@@ -139,18 +139,6 @@ const Bundled& BundledLog() {
   return bundled;
 }
 
-// Every step-th of the bundled log's queries (Algorithm 4, 500 starts, default query keypoints):
-// built alone, each is the query built among all of them (queries cost seconds under the
-// sanitizers; most tests need a few).
-std::vector<LocalizationQuery> QueriesEvery(std::size_t step) {
-  const testing::BundledMap& log = testing::BundledFr079();
-  const std::vector<int> all = QueryStarts(log.truth, 500);
-  std::vector<int> starts;
-  for (std::size_t i = 0; i < all.size(); i += step) starts.push_back(all[i]);
-  return BuildSubmapQueries(log.inputs, log.truth, log.map.config, starts,
-                            PlaceRecognitionConfig{}.query_keypoints);
-}
-
 TEST(DescriptorIndexBound, RootDistanceIsAtMostTwiceTheChi2OnTheBundledLog) {
   const std::vector<BetaGridDescriptor>& all = BundledLog().descriptors;
   ASSERT_GT(all.size(), 10000u);
@@ -407,7 +395,7 @@ TEST(DescriptorIndex, RecognizerGivesTheSameMatchesOnRandomPlaces) {
 // query (the exhaustive answers take most of this test's time).
 TEST(DescriptorIndex, SameAnswerAsExhaustiveOnEveryQueryOfTheBundledLog) {
   const Bundled& b = BundledLog();
-  const std::vector<LocalizationQuery> queries = QueriesEvery(1);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(1);
   ASSERT_GT(queries.size(), 480u);
   const PlaceRecognitionConfig base;  // default preset
   PlaceRecognitionConfig none = base;
@@ -478,7 +466,8 @@ TEST(PlaceDatabase, AddAndRemoveGiveTheAnswersOfARecognizerBuiltAtOnceOnTheBundl
                              : kind == Index::kKdTree ? "kdtree"
                                                       : "none";
     // Every 20th query (every 100th for the exhaustive search, which dominates this test's time).
-    const std::vector<LocalizationQuery> queries = QueriesEvery(kind == Index::kNone ? 100 : 20);
+    const std::vector<LocalizationQuery> queries =
+        testing::BundledQueriesEvery(kind == Index::kNone ? 100 : 20);
     PlaceRecognitionConfig config;  // default preset
     config.descriptor_index = kind;
 
@@ -536,7 +525,7 @@ TEST(PlaceDatabase, CopiesDoNotShareChangesAndBadInputThrows) {
   for (auto it = all.end() - 5; it != all.end(); ++it) copy.AddPlace(*it);
   ASSERT_TRUE(copy.RemovePlace(all.front().id));
   EXPECT_EQ(original.places().size(), all.size() - 5);
-  const std::vector<LocalizationQuery> queries = QueriesEvery(10);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(10);
   ExpectSameAnswers(queries, original, std::vector<Place>(all.begin(), all.end() - 5), "original");
   ExpectSameAnswers(queries, copy, std::vector<Place>(all.begin() + 1, all.end()), "copy");
 

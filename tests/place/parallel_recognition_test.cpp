@@ -41,14 +41,7 @@ std::vector<PlaceMatch> AnswersOnThreads(const PlaceRecognizer& recognizer,
 }
 
 // Every 10th of the 500 queries of `keyplace localize` on the bundled log (all-scan keypoints).
-std::vector<LocalizationQuery> Queries() {
-  const testing::BundledMap& log = testing::BundledFr079();
-  const std::vector<int> all = QueryStarts(log.truth, 500);
-  std::vector<int> starts;  // built alone, each query is the one built among all of them
-  for (std::size_t i = 0; i < all.size(); i += 10) starts.push_back(all[i]);
-  return BuildSubmapQueries(log.inputs, log.truth, log.map.config, starts,
-                            PlaceRecognitionConfig{}.query_keypoints);
-}
+std::vector<LocalizationQuery> Queries() { return testing::BundledQueriesEvery(10); }
 
 struct Setting {
   std::string name;

@@ -24,15 +24,7 @@ namespace keyplace {
 namespace {
 
 // Every 20th of the 500 queries of `keyplace localize` on the bundled log (all-scan keypoints).
-std::vector<LocalizationQuery> Queries() {
-  const testing::BundledMap& log = testing::BundledFr079();
-  // Every 20th of 500 starts: built alone, each query is the one built among all of them.
-  const std::vector<int> all = QueryStarts(log.truth, 500);
-  std::vector<int> starts;
-  for (std::size_t i = 0; i < all.size(); i += 20) starts.push_back(all[i]);
-  return BuildSubmapQueries(log.inputs, log.truth, log.map.config, starts,
-                            PlaceRecognitionConfig{}.query_keypoints);
-}
+std::vector<LocalizationQuery> Queries() { return testing::BundledQueriesEvery(20); }
 
 // Thresholds in no particular order, mu and gamma both above and below the defaults, one
 // repeated; the stable-keypoint gamma differs from the all-scan one.

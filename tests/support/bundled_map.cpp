@@ -1,6 +1,7 @@
 #include "support/bundled_map.hpp"
 
 #include "keyplace/mapping/global_mapper.hpp"
+#include "keyplace/place/place_config.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace::testing {
@@ -20,6 +21,15 @@ const BundledMap& BundledFr079() {
     return b;
   }();
   return bundled;
+}
+
+std::vector<LocalizationQuery> BundledQueriesEvery(std::size_t step) {
+  const BundledMap& log = BundledFr079();
+  const std::vector<int> all = QueryStarts(log.truth, 500);
+  std::vector<int> starts;
+  for (std::size_t i = 0; i < all.size(); i += step) starts.push_back(all[i]);
+  return BuildSubmapQueries(log.inputs, log.truth, log.map.config, starts,
+                            PlaceRecognitionConfig{}.query_keypoints);
 }
 
 }  // namespace keyplace::testing
