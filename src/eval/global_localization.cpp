@@ -10,15 +10,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "common/seconds_since.hpp"
 #include "eval/parallel_progress.hpp"
 #include "keyplace/localization/query_builder.hpp"
 
 namespace keyplace {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // The evaluated scan of a query submap (its latest scan with a truth pose) and the sorted truth
 // indices of its scans.

@@ -5,12 +5,10 @@
 #include <string>
 #include <utility>
 
+#include "common/seconds_since.hpp"
+
 namespace keyplace {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // A QueryProgress reporting as `stage` of `progress` (nothing when `progress` is empty).
 QueryProgress AsStage(const StageProgress& progress, const std::string& stage) {

@@ -31,7 +31,7 @@ std::string ToString(ScanOrder order) {
   return "?";
 }
 
-std::vector<std::size_t> ProcessingOrder(const std::vector<LogScan>& scans, ScanOrder order) {
+std::vector<std::size_t> ProcessingSequence(const std::vector<LogScan>& scans, ScanOrder order) {
   std::vector<std::size_t> indices(scans.size());
   std::iota(indices.begin(), indices.end(), std::size_t{0});
   if (order == ScanOrder::kLogger) {
@@ -94,7 +94,7 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
         (options.source.empty() ? "" : options.source + ": ") +
             (logger ? "the logger timestamps" : "the ipc timestamps"));
   }
-  const std::vector<std::size_t> order = ProcessingOrder(scans, options.order);
+  const std::vector<std::size_t> order = ProcessingSequence(scans, options.order);
   const std::size_t end = std::min(options.end, order.size());
   const std::size_t begin = std::min(options.begin, end);
 

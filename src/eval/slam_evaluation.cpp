@@ -5,14 +5,11 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "common/seconds_since.hpp"
 #include "keyplace/io/timestamps.hpp"
 
 namespace keyplace {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 LoopPrecisions Precisions(const LoopEvaluation& e) {
   LoopPrecisions p;

@@ -20,12 +20,6 @@ namespace {
 // A chunk is about 768 KiB by default; a length beyond this is damage, not data.
 constexpr std::uint32_t kMaxRecordBytes = 1U << 30;
 
-struct Connection {
-  std::string topic;
-  std::string datatype;
-  std::string md5sum;
-};
-
 class ChunkWalker {
  public:
   ChunkWalker(const std::string& path, const std::set<std::string>& topics,
@@ -121,7 +115,7 @@ class ChunkWalker {
 
   void AddConnection(const BagFields& fields, const std::uint8_t* data, std::uint32_t size) {
     const auto connection_fields = ParseFields(data, size);
-    Connection connection;
+    BagConnection connection;
     connection.topic = fields.count("topic") != 0 ? fields.at("topic") : "";
     if (connection_fields) {
       connection.datatype = connection_fields->count("type") ? connection_fields->at("type") : "";
@@ -134,7 +128,7 @@ class ChunkWalker {
                     std::uint64_t chunk_offset) {
     const auto it = connections_.find(FieldU32(fields, "conn").value_or(0));
     if (it == connections_.end()) FailChunk(chunk_offset, "a message of an unknown connection");
-    const Connection& connection = it->second;
+    const BagConnection& connection = it->second;
     ++counts_[connection.topic];
     ++messages_;
     if (topics_.count(connection.topic) == 0) return;
@@ -180,7 +174,7 @@ class ChunkWalker {
   const RawMessageVisitor& visitor_;
   std::ifstream file_;
   std::uint64_t file_bytes_ = 0;
-  std::map<std::uint32_t, Connection> connections_;
+  std::map<std::uint32_t, BagConnection> connections_;
   std::map<std::string, std::size_t> counts_;
   std::size_t messages_ = 0;
   std::size_t chunks_ = 0;

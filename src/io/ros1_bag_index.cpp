@@ -77,13 +77,6 @@ std::map<std::uint64_t, FileRecord> WalkFileRecords(std::ifstream& file, std::ui
   return records;
 }
 
-// A connection as the index's connection record describes it.
-struct Connection {
-  std::string topic;
-  std::string datatype;
-  std::string md5sum;
-};
-
 // One entry of a connection's index data: the message at byte `offset` of the records of the
 // chunk at byte `chunk`, received at sec/nsec; `data` holds the message of a wanted topic.
 struct IndexEntry {
@@ -160,7 +153,7 @@ class IndexReader {
     BagSummary summary;
     for (const auto& [id, entries] : entries_) {
       if (entries.empty()) continue;
-      const Connection& connection = connections_.at(id);
+      const BagConnection& connection = connections_.at(id);
       LogTopic& topic = by_name[connection.topic];
       topic.name = connection.topic;
       topic.type = connection.datatype;
@@ -196,7 +189,7 @@ class IndexReader {
     while (!cursors.empty()) {
       Cursor& cursor = cursors.back();
       const IndexEntry& entry = (*cursor.entries)[cursor.next];
-      const Connection& connection = connections_.at(cursor.connection);
+      const BagConnection& connection = connections_.at(cursor.connection);
       visitor({connection.topic, connection.datatype, connection.md5sum, entry.sec, entry.nsec,
                entry.data.data(), static_cast<std::uint32_t>(entry.data.size())});
       if (++cursor.next == cursor.entries->size()) cursors.pop_back();
@@ -277,7 +270,7 @@ class IndexReader {
       return it == header->end() ? std::string() : it->second;
     };
     // The first record of an id counts, as in rosbag.
-    connections_.emplace(id, Connection{topic->second, field("type"), field("md5sum")});
+    connections_.emplace(id, BagConnection{topic->second, field("type"), field("md5sum")});
   }
 
   // The chunk's position and how many index data records follow it: one per distinct connection
@@ -396,7 +389,7 @@ class IndexReader {
   const std::string& path_;
   std::ifstream& file_;
   const std::map<std::uint64_t, FileRecord>& records_;
-  std::map<std::uint32_t, Connection> connections_;
+  std::map<std::uint32_t, BagConnection> connections_;
   std::map<std::uint32_t, std::vector<IndexEntry>> entries_;  // by connection, in index order
   // Chunk position -> its entries (connection, position in entries_[connection]).
   std::map<std::uint64_t, std::vector<std::pair<std::uint32_t, std::size_t>>> entries_by_chunk_;

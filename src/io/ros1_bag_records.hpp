@@ -27,6 +27,13 @@ inline constexpr std::uint8_t kOpConnection = 0x07;
 
 using BagFields = std::map<std::string, std::string>;
 
+/// A connection (op 7): the topic and the message type it carries.
+struct BagConnection {
+  std::string topic;
+  std::string datatype;
+  std::string md5sum;
+};
+
 std::uint32_t ReadU32(const std::uint8_t* bytes);
 std::uint64_t ReadU64(const std::uint8_t* bytes);
 

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "common/config_fields.hpp"
+#include "common/seconds_since.hpp"
 #include "config/section_tables.hpp"
 #include "io/atomic_file.hpp"
 #include "keyplace_generated/preparation_code_hash.hpp"
@@ -86,10 +87,6 @@ std::vector<std::vector<Keypoint>> ExtractKeypoints(const CarmenLog& log,
 }
 
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 template <typename Config>
 void AppendSettings(const std::string& section, const ConfigFields<Config>& fields,

@@ -57,6 +57,11 @@ void FillRoots(const BetaGridDescriptor& descriptor, double* row) {
   }
 }
 
+}  // namespace
+
+// Named, not anonymous: SqrtDescriptorIndex::KdTree, a class with external linkage, holds these.
+namespace descriptor_kdtree {
+
 // nanoflann reads the rows [begin, begin + count) of the roots through this adaptor (no copy;
 // through the vector, which may reallocate as places are added).
 struct RootsAdaptor {
@@ -81,14 +86,15 @@ using RootsTree = nanoflann::KDTreeSingleIndexAdaptor<
 // Leaf size of the kd-tree: 10 and 20 measured alike on FR079 (docs/BENCHMARKS.md).
 constexpr std::size_t kLeafSize = 16;
 
-}  // namespace
+}  // namespace descriptor_kdtree
 
 struct SqrtDescriptorIndex::KdTree {
-  RootsAdaptor adaptor;
-  RootsTree tree;  // built by its constructor
+  descriptor_kdtree::RootsAdaptor adaptor;
+  descriptor_kdtree::RootsTree tree;  // built by its constructor
   KdTree(const std::vector<double>& roots, std::size_t begin, std::size_t count)
       : adaptor{&roots, begin, count},
-        tree(kBetaGridBins, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {}
+        tree(kBetaGridBins, adaptor,
+             nanoflann::KDTreeSingleIndexAdaptorParams(descriptor_kdtree::kLeafSize)) {}
 };
 
 SqrtDescriptorIndex::SqrtDescriptorIndex(const std::vector<Place>& places,

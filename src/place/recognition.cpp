@@ -19,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "common/seconds_since.hpp"
 #include "keyplace/place/dense_check.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 #include "keyplace/place/ransac.hpp"
@@ -30,10 +31,6 @@ namespace keyplace {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 double SelectionScore(PlaceRecognitionConfig::Score score, int consensus, double gamma) {
   switch (score) {

@@ -11,7 +11,8 @@
 #include <nanoflann.hpp>
 
 namespace keyplace {
-namespace {
+// Named, not anonymous: IcpTarget::Impl, a class with external linkage, holds these.
+namespace icp_kdtree {
 
 // nanoflann reads the caller's points through this adaptor (no copy).
 struct PointsAdaptor {
@@ -29,11 +30,18 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
     nanoflann::L2_Simple_Adaptor<double, PointsAdaptor, double, std::size_t>, PointsAdaptor, 2,
     std::size_t>;
 
+}  // namespace icp_kdtree
+
+namespace {
+
+using icp_kdtree::KdTree;
+using icp_kdtree::PointsAdaptor;
+
 constexpr int kMaxNormalNeighbours = 64;
 // How many past iterates are checked for a cycle of the association.
 constexpr int kCycleMemory = 10;
 
-void Require(bool condition, const char* field, const char* what) {
+void RequireIcpField(bool condition, const char* field, const char* what) {
   if (!condition) {
     throw std::invalid_argument(std::string("IcpConfig.") + field + " " + what);
   }
@@ -93,23 +101,24 @@ std::string ToString(RobustKernel kernel) {
 }
 
 void ValidateIcpConfig(const IcpConfig& c) {
-  Require(c.max_correspondence_distance_m > 0.0, "max_correspondence_distance_m", "must be > 0");
-  Require(c.inlier_distance_m > 0.0, "inlier_distance_m", "must be > 0");
-  Require(c.kernel_scale_m > 0.0, "kernel_scale_m", "must be > 0");
-  Require(c.normal_neighbours >= 2 && c.normal_neighbours <= kMaxNormalNeighbours,
-          "normal_neighbours", "must be in [2, 64]");
-  Require(c.normal_max_neighbour_distance_m > 0.0, "normal_max_neighbour_distance_m",
-          "must be > 0");
-  Require(c.normal_max_eigenvalue_ratio >= 0.0 && c.normal_max_eigenvalue_ratio <= 1.0,
-          "normal_max_eigenvalue_ratio", "must be in [0, 1]");
-  Require(c.max_iterations >= 1, "max_iterations", "must be >= 1");
-  Require(c.convergence_translation_m >= 0.0, "convergence_translation_m", "must be >= 0");
-  Require(c.convergence_rotation_rad >= 0.0, "convergence_rotation_rad", "must be >= 0");
-  Require(c.degeneracy_min_eigenvalue >= 0.0, "degeneracy_min_eigenvalue", "must be >= 0");
-  Require(c.min_points >= 3, "min_points", "must be >= 3");
-  Require(c.min_inliers >= 0, "min_inliers", "must be >= 0");
-  Require(c.min_inlier_ratio >= 0.0 && c.min_inlier_ratio <= 1.0, "min_inlier_ratio",
-          "must be in [0, 1]");
+  RequireIcpField(c.max_correspondence_distance_m > 0.0, "max_correspondence_distance_m",
+                  "must be > 0");
+  RequireIcpField(c.inlier_distance_m > 0.0, "inlier_distance_m", "must be > 0");
+  RequireIcpField(c.kernel_scale_m > 0.0, "kernel_scale_m", "must be > 0");
+  RequireIcpField(c.normal_neighbours >= 2 && c.normal_neighbours <= kMaxNormalNeighbours,
+                  "normal_neighbours", "must be in [2, 64]");
+  RequireIcpField(c.normal_max_neighbour_distance_m > 0.0, "normal_max_neighbour_distance_m",
+                  "must be > 0");
+  RequireIcpField(c.normal_max_eigenvalue_ratio >= 0.0 && c.normal_max_eigenvalue_ratio <= 1.0,
+                  "normal_max_eigenvalue_ratio", "must be in [0, 1]");
+  RequireIcpField(c.max_iterations >= 1, "max_iterations", "must be >= 1");
+  RequireIcpField(c.convergence_translation_m >= 0.0, "convergence_translation_m", "must be >= 0");
+  RequireIcpField(c.convergence_rotation_rad >= 0.0, "convergence_rotation_rad", "must be >= 0");
+  RequireIcpField(c.degeneracy_min_eigenvalue >= 0.0, "degeneracy_min_eigenvalue", "must be >= 0");
+  RequireIcpField(c.min_points >= 3, "min_points", "must be >= 3");
+  RequireIcpField(c.min_inliers >= 0, "min_inliers", "must be >= 0");
+  RequireIcpField(c.min_inlier_ratio >= 0.0 && c.min_inlier_ratio <= 1.0, "min_inlier_ratio",
+                  "must be in [0, 1]");
 }
 
 // ------------------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kMaxRecoveryPoses = 1e6;
 
-void Require(bool condition, const char* field, const char* what) {
+void RequireOdometryField(bool condition, const char* field, const char* what) {
   if (!condition) {
     throw std::invalid_argument(std::string("ScanOdometryConfig.") + field + " " + what);
   }
@@ -58,32 +58,38 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
   } catch (const std::invalid_argument& error) {
     throw std::invalid_argument(std::string("ScanOdometryConfig.icp: ") + error.what());
   }
-  Require(c.min_range_m >= 0.0, "min_range_m", "must be >= 0");
-  Require(c.max_range_m > c.min_range_m, "max_range_m", "must be > min_range_m");
-  Require(c.source_min_spacing_m >= 0.0, "source_min_spacing_m", "must be >= 0");
-  Require(c.local_map_scans >= 1, "local_map_scans", "must be >= 1");
-  Require(c.keyframe_translation_m >= 0.0, "keyframe_translation_m", "must be >= 0");
-  Require(c.keyframe_rotation_rad >= 0.0, "keyframe_rotation_rad", "must be >= 0");
-  Require(c.max_correction_translation_m > 0.0, "max_correction_translation_m", "must be > 0");
-  Require(c.max_correction_rotation_rad > 0.0, "max_correction_rotation_rad", "must be > 0");
-  Require(c.recovery_window_translation_m >= 0.0 && c.recovery_window_translation_m <= 10.0,
-          "recovery_window_translation_m", "must be in [0, 10]");
-  Require(c.recovery_window_rotation_rad >= 0.0 && c.recovery_window_rotation_rad <= M_PI,
-          "recovery_window_rotation_rad", "must be in [0, pi]");
-  Require(std::isfinite(c.recovery_step_translation_m) && c.recovery_step_translation_m >= 0.01,
-          "recovery_step_translation_m", "must be finite and >= 0.01");
-  Require(std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
-          "recovery_step_rotation_rad", "must be finite and >= 0.001");
+  RequireOdometryField(c.min_range_m >= 0.0, "min_range_m", "must be >= 0");
+  RequireOdometryField(c.max_range_m > c.min_range_m, "max_range_m", "must be > min_range_m");
+  RequireOdometryField(c.source_min_spacing_m >= 0.0, "source_min_spacing_m", "must be >= 0");
+  RequireOdometryField(c.local_map_scans >= 1, "local_map_scans", "must be >= 1");
+  RequireOdometryField(c.keyframe_translation_m >= 0.0, "keyframe_translation_m", "must be >= 0");
+  RequireOdometryField(c.keyframe_rotation_rad >= 0.0, "keyframe_rotation_rad", "must be >= 0");
+  RequireOdometryField(c.max_correction_translation_m > 0.0, "max_correction_translation_m",
+                       "must be > 0");
+  RequireOdometryField(c.max_correction_rotation_rad > 0.0, "max_correction_rotation_rad",
+                       "must be > 0");
+  RequireOdometryField(
+      c.recovery_window_translation_m >= 0.0 && c.recovery_window_translation_m <= 10.0,
+      "recovery_window_translation_m", "must be in [0, 10]");
+  RequireOdometryField(
+      c.recovery_window_rotation_rad >= 0.0 && c.recovery_window_rotation_rad <= M_PI,
+      "recovery_window_rotation_rad", "must be in [0, pi]");
+  RequireOdometryField(
+      std::isfinite(c.recovery_step_translation_m) && c.recovery_step_translation_m >= 0.01,
+      "recovery_step_translation_m", "must be finite and >= 0.01");
+  RequireOdometryField(
+      std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
+      "recovery_step_rotation_rad", "must be finite and >= 0.001");
   // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 91 =
   // 11 011 poses (2-6 ms); this bound keeps a search under about a second.
   const double translations =
       2.0 * std::floor(c.recovery_window_translation_m / c.recovery_step_translation_m) + 1.0;
   const double rotations =
       2.0 * std::floor(c.recovery_window_rotation_rad / c.recovery_step_rotation_rad) + 1.0;
-  Require(translations * translations * rotations <= kMaxRecoveryPoses,
-          "recovery_window_translation_m",
-          "and the other recovery_window_* / recovery_step_* fields give more than 1 000 000 "
-          "searched poses");
+  RequireOdometryField(
+      translations * translations * rotations <= kMaxRecoveryPoses, "recovery_window_translation_m",
+      "and the other recovery_window_* / recovery_step_* fields give more than 1 000 000 "
+      "searched poses");
 }
 
 ScanOdometry::ScanOdometry(const ScanOdometryConfig& config) : config_(config) {

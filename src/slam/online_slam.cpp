@@ -6,14 +6,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/seconds_since.hpp"
+
 namespace keyplace {
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void Validate(const SlamConfig& config) {
   ValidateScanOdometryConfig(config.odometry);

@@ -77,9 +77,9 @@ TEST(OdometryEvaluationTest, ProcessingOrderSortsStablyByTheChosenStamp) {
   // ipc: 5, 7, 6, 6 -> 0, 2, 3, 1.
   const std::vector<LogScan> scans = {StampedScan(3.0, 5.0), StampedScan(1.0, 7.0),
                                       StampedScan(1.0, 6.0), StampedScan(0.0, 6.0)};
-  EXPECT_EQ(ProcessingOrder(scans, ScanOrder::kLogger), (std::vector<std::size_t>{3, 1, 2, 0}));
-  EXPECT_EQ(ProcessingOrder(scans, ScanOrder::kIpc), (std::vector<std::size_t>{0, 2, 3, 1}));
-  EXPECT_EQ(ProcessingOrder(scans, ScanOrder::kFile), (std::vector<std::size_t>{0, 1, 2, 3}));
+  EXPECT_EQ(ProcessingSequence(scans, ScanOrder::kLogger), (std::vector<std::size_t>{3, 1, 2, 0}));
+  EXPECT_EQ(ProcessingSequence(scans, ScanOrder::kIpc), (std::vector<std::size_t>{0, 2, 3, 1}));
+  EXPECT_EQ(ProcessingSequence(scans, ScanOrder::kFile), (std::vector<std::size_t>{0, 1, 2, 3}));
   for (const char* name : {"logger", "ipc", "file"}) {
     EXPECT_EQ(ToString(ParseScanOrder(name)), name);
   }

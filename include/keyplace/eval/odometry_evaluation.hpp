@@ -29,7 +29,7 @@ ScanOrder ParseScanOrder(const std::string& text);
 std::string ToString(ScanOrder order);
 
 /// Indices into `scans` (file order) in processing order.
-std::vector<std::size_t> ProcessingOrder(const std::vector<LogScan>& scans, ScanOrder order);
+std::vector<std::size_t> ProcessingSequence(const std::vector<LogScan>& scans, ScanOrder order);
 
 struct OdometryRunOptions {
   ScanOrder order = ScanOrder::kLogger;
