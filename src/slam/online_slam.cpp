@@ -37,8 +37,8 @@ void Validate(const SlamConfig& config) {
   if (config.optimize_every_loops < 1) fail("optimize_every_loops", "must be >= 1");
 }
 
-OnlineSlam::OnlineSlam(const SlamConfig& config)
-    : config_(config), odometry_(config.odometry), mapper_(config.mapping) {
+OnlineSlam::OnlineSlam(const SlamConfig& config, const FlirtConfig& features)
+    : config_(config), extractor_(features), odometry_(config.odometry), mapper_(config.mapping) {
   Validate(config_);
   map_.config = config_.mapping;
   map_.pose_source = "slam";
@@ -49,6 +49,12 @@ OnlineSlam::~OnlineSlam() = default;
 bool OnlineSlam::QueriesWithAllScans() const {
   return config_.all_scan_loop_queries &&
          config_.place.query_keypoints == PlaceRecognitionConfig::QueryKeypoints::kAllScans;
+}
+
+SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
+                             const std::optional<Pose2>& T_odom_robot) {
+  const Pose2 T_odom_laser = T_odom_robot.value_or(Pose2()) * scan.T_robot_laser;
+  return AddScan(scan_index, scan, T_odom_robot, extractor_.Extract(scan, T_odom_laser));
 }
 
 SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -189,6 +190,47 @@ TEST(OnlineSlam, AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld) {
         << "loop " << loop.query_submap << " -> " << loop.reference_submap;
   }
   EXPECT_LT(drift(*all_scans), 1.0) << "stable queries: " << drift(*stable);
+}
+
+// The stable keypoints of every submap, in order, as (x, y) of each: what the keypoints given to
+// AddScan decide.
+std::vector<std::pair<double, double>> SubmapKeypoints(const OnlineSlam& slam) {
+  std::vector<std::pair<double, double>> positions;
+  for (const Submap& submap : slam.map().submaps) {
+    for (const StableKeypoint& keypoint : submap.keypoints) {
+      positions.emplace_back(keypoint.position_m.x(), keypoint.position_m.y());
+    }
+  }
+  return positions;
+}
+
+// Scan in, poses out: AddScan without keypoints extracts them as a log's are prepared (FLIRT in
+// the odometry frame), so it builds the map and trajectory of the keypoints path exactly. A
+// quarter lap, a few submaps; the keypoints of the identity frame would give other submaps.
+TEST(OnlineSlam, ScanInEntryExtractsTheKeypointsOfTheOdometryFrame) {
+  const SimulatedRun run = Simulate(0.25);
+  const FlirtExtractor extractor;
+  SlamConfig config = SimulationConfig();
+  OnlineSlam given(config), scan_in(config), identity_frame(config);
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const LogScan& scan = run.scans[i];
+    const Pose2 T_odom_laser = scan.odometry_pose.value() * scan.T_robot_laser;
+    given.AddScan(static_cast<int>(i), scan, scan.odometry_pose,
+                  extractor.Extract(scan, T_odom_laser));
+    scan_in.AddScan(static_cast<int>(i), scan, scan.odometry_pose);
+    identity_frame.AddScan(static_cast<int>(i), scan, scan.odometry_pose, extractor.Extract(scan));
+  }
+  ASSERT_GE(given.map().submaps.size(), 2u);
+  EXPECT_EQ(SubmapKeypoints(scan_in), SubmapKeypoints(given));
+  EXPECT_NE(SubmapKeypoints(identity_frame), SubmapKeypoints(given));
+  const std::vector<OnlineSlam::ScanPose> expected = given.Trajectory();
+  const std::vector<OnlineSlam::ScanPose> trajectory = scan_in.Trajectory();
+  ASSERT_EQ(trajectory.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(trajectory[i].T_world_robot.x, expected[i].T_world_robot.x) << "scan " << i;
+    EXPECT_EQ(trajectory[i].T_world_robot.theta, expected[i].T_world_robot.theta) << "scan " << i;
+    EXPECT_EQ(trajectory[i].submap, expected[i].submap) << "scan " << i;
+  }
 }
 
 TEST(OnlineSlam, RejectsInvalidConfig) {

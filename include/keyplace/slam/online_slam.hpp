@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/features/flirt.hpp"
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/mapping/global_map.hpp"
@@ -145,8 +146,9 @@ struct SlamStats {
 
 class OnlineSlam {
  public:
-  /// Throws std::invalid_argument (Validate) for an invalid config.
-  explicit OnlineSlam(const SlamConfig& config = {});
+  /// Throws std::invalid_argument (Validate) for an invalid config. `features` configures the
+  /// FLIRT extraction of the AddScan that takes no keypoints.
+  explicit OnlineSlam(const SlamConfig& config = {}, const FlirtConfig& features = {});
   ~OnlineSlam();
   OnlineSlam(const OnlineSlam&) = delete;
   OnlineSlam& operator=(const OnlineSlam&) = delete;
@@ -156,6 +158,11 @@ class OnlineSlam {
   /// file index), kept in the submaps and poses.
   SlamStep AddScan(int scan_index, const LaserScan& scan, const std::optional<Pose2>& T_odom_robot,
                    const std::vector<Keypoint>& keypoints);
+
+  /// The same with the keypoints extracted here (FLIRT with the constructor's `features`, their
+  /// duplicate box along the axes of the odometry frame, as keyplace prepares a log's keypoints),
+  /// as GlobalLocalizer::AddScan takes a scan: scan and odometry in, the step's poses out.
+  SlamStep AddScan(int scan_index, const LaserScan& scan, const std::optional<Pose2>& T_odom_robot);
 
   /// Optimises the graph once more (if it has loops) and updates the map's poses.
   void Finish();
@@ -197,6 +204,7 @@ class OnlineSlam {
   void ApplyGraph();
 
   SlamConfig config_;
+  FlirtExtractor extractor_;
   ScanOdometry odometry_;
   LocalMapper mapper_;
   PoseGraph graph_;
