@@ -90,7 +90,7 @@ OdometryRun RunScanOdometry(const std::vector<LogScan>& scans, const ScanOdometr
 
 /// One step of a run: a registered scan against the scan before it in processing order, as ICP
 /// estimated it and as the wheel odometry measured it, so that the places where the two part can
-/// be found (keyplace odometry --steps; docs/SLAM.md, "The hospital bag"). The run's first scan
+/// be found (keyplace odometry --steps; docs/notes/slam-hospital-bag.md). The run's first scan
 /// is a step of zero from nowhere (identity, no odometry step).
 struct OdometryStep {
   std::size_t scan_index = 0;  // the later scan, file order
