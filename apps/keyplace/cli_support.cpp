@@ -37,33 +37,6 @@ void RunOnWorkerThreads(int threads, const std::function<void()>& work) {
   arena.execute(work);
 }
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void PrintLogWarnings(const CarmenLog& log) {
-  for (const std::string& warning : log.warnings)
-    fmt::print(stderr, "keyplace: warning: {}\n", warning);
-}
-
-void PrintInputsWarnings(const LogInputs& inputs) {
-  PrintLogWarnings(inputs.log);
-  for (const std::string& warning : inputs.cache_warnings) {
-    fmt::print(stderr, "keyplace: warning: cache entry {}\n", warning);
-  }
-  if (inputs.poses_from_cache || inputs.keypoints_from_cache) {
-    fmt::print(stderr, "keyplace: {} of {} read from the cache\n",
-               inputs.poses_from_cache && inputs.keypoints_from_cache
-                   ? "poses and keypoints"
-                   : (inputs.poses_from_cache ? "poses" : "keypoints"),
-               inputs.source_log);
-  }
-}
-
-void WriteJson(const std::string& path, const nlohmann::json& json) {
-  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
-}
-
 namespace {
 
 // Every value given to `command`'s options and positionals but those of `outputs`.
@@ -164,74 +137,6 @@ void ApplyScanRange(const std::string& text, LogInputOptions& options) {
   options.end_scan = range.end;
 }
 
-Progress::Progress(std::string label, std::size_t total)
-    : label_(std::move(label)),
-      total_(total),
-      start_(std::chrono::steady_clock::now()),
-      last_print_(start_) {
-  const char* env = std::getenv("KEYPLACE_PROGRESS");
-  const std::string setting = env != nullptr ? env : "";
-  if (setting == "0") {
-    mode_ = Mode::kOff;
-  } else if (setting == "1") {
-    mode_ = Mode::kBar;
-  } else if (setting == "lines") {
-    mode_ = Mode::kLines;
-  } else {
-    mode_ = isatty(fileno(stderr)) != 0 ? Mode::kBar : Mode::kLines;
-  }
-}
-
-void Progress::Update(std::size_t done) {
-  if (mode_ == Mode::kOff || total_ == 0) return;
-  const auto now = std::chrono::steady_clock::now();
-  const auto interval = mode_ == Mode::kBar ? std::chrono::duration<double>(0.25)
-                                            : std::chrono::duration<double>(kProgressLineSeconds);
-  if (started_ && now - last_print_ < interval && done < total_) return;
-  if (mode_ == Mode::kLines && done == total_) return;  // Finish says it
-  started_ = true;
-  last_print_ = now;
-  const double elapsed_s = std::chrono::duration<double>(now - start_).count();
-  const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-  const std::string eta = fraction > 0.0
-                              ? fmt::format("ETA {:.0f} s", elapsed_s * (1.0 - fraction) / fraction)
-                              : std::string("started");
-  if (mode_ == Mode::kBar) {
-    fmt::print(stderr, "\r{}  {}/{}  {:3.0f} %  {}   ", label_, done, total_, 100.0 * fraction,
-               eta);
-  } else {
-    fmt::print(stderr, "keyplace: {}  {}/{}  {:.0f} %  {}\n", label_, done, total_,
-               100.0 * fraction, eta);
-  }
-  std::fflush(stderr);
-}
-
-void Progress::Finish() {
-  if (mode_ == Mode::kOff || total_ == 0) return;
-  const double elapsed_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (mode_ == Mode::kBar) {
-    fmt::print(stderr, "\r{}  {}/{}  done in {:.1f} s          \n", label_, total_, total_,
-               elapsed_s);
-  } else {
-    fmt::print(stderr, "keyplace: {}  {}/{}  done in {:.1f} s\n", label_, total_, total_,
-               elapsed_s);
-  }
-}
-
-StageProgress StageProgressBar() {
-  auto current = std::make_shared<std::unique_ptr<Progress>>();
-  auto stage_name = std::make_shared<std::string>();
-  return [current, stage_name](const std::string& stage, std::size_t done, std::size_t total) {
-    if (*current == nullptr || *stage_name != stage) {
-      *current = std::make_unique<Progress>(stage, total);
-      *stage_name = stage;
-    }
-    (*current)->Update(done);
-    if (done == total) (*current)->Finish();
-  };
-}
-
 std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path) {
   if (yaml_path.empty()) return {};
   const std::string extension = std::filesystem::path(yaml_path).extension().string();
@@ -240,32 +145,6 @@ std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& 
                                 ": expected a .yaml file (its image goes beside it as .pgm)");
   }
   return {{"--grid", yaml_path}, {"--grid (its image)", MapServerImagePath(yaml_path)}};
-}
-
-void WriteGrid(const std::string& yaml_path, const OccupancyGrid& grid,
-               const OccupancyGridConfig& config) {
-  WriteMapServerMap(grid, config, yaml_path);
-  fmt::print("occupancy grid written to {} and {} ({} x {} cells of {} m, origin {:.3f} {:.3f})\n",
-             yaml_path, MapServerImagePath(yaml_path), grid.width, grid.height, grid.resolution_m,
-             grid.origin_m.x(), grid.origin_m.y());
-}
-
-void PrintGridAgreement(const GridAgreement& agreement) {
-  fmt::print(
-      "grid vs corrected-pose grid: {:.1f} % of its {} occupied cells within {} m of an occupied "
-      "reference cell, {:.1f} % of the reference's {} matched, {:.2f} % in free reference space\n",
-      100.0 * agreement.occupied_matched, agreement.occupied, agreement.tolerance_m,
-      100.0 * agreement.reference_matched, agreement.occupied_reference,
-      100.0 * agreement.occupied_on_free);
-}
-
-nlohmann::json GridAgreementJson(const GridAgreement& agreement) {
-  return {{"tolerance_m", agreement.tolerance_m},
-          {"occupied", agreement.occupied},
-          {"occupied_reference", agreement.occupied_reference},
-          {"occupied_matched", agreement.occupied_matched},
-          {"reference_matched", agreement.reference_matched},
-          {"occupied_on_free", agreement.occupied_on_free}};
 }
 
 }  // namespace keyplace::cli

@@ -1,7 +1,7 @@
 #pragma once
-// Helpers shared by the subcommands: output files, JSON, progress, argument parsing.
+// Helpers shared by the subcommands: option help, threads, scan ranges, output checks (with
+// command_output.hpp and progress.hpp from tools/).
 
-#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -9,11 +9,12 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
-#include "keyplace/eval/grid_agreement.hpp"
+#include "command_output.hpp"
+#include "common/seconds_since.hpp"
 #include "keyplace/io/carmen_log.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
+#include "progress.hpp"
 
 namespace keyplace::cli {
 
@@ -26,20 +27,12 @@ inline CarmenLog ReadLogWithScans(const std::string& path, const CarmenReadOptio
 inline constexpr const char* kSkipBadLinesHelp =
     "Skip malformed log lines (counted and reported) instead of stopping at the first one";
 
-/// Prints the reader's warnings about a log (a dropped cut-off last line, skipped lines) to
-/// stderr, one "keyplace: warning: ..." line each.
-void PrintLogWarnings(const CarmenLog& log);
-
 /// Help text of --cache (LogInputOptions::cache_dir).
 inline constexpr const char* kCacheHelp =
     "Directory keeping the log's ICP poses and FLIRT keypoints between runs (created if "
     "missing): a later run over the same log with the same settings reads them instead of "
     "computing them; the results are the same bit for bit. Entries are keyed by the log's "
     "content, the settings and the code that computes them";
-
-/// PrintLogWarnings of the inputs' log, the damaged cache entries and, when the cache gave the
-/// poses or keypoints, one line saying so.
-void PrintInputsWarnings(const LogInputs& inputs);
 
 /// The worker threads of --threads N: N, or every core when N is 0. Throws
 /// std::invalid_argument for N < 0.
@@ -49,12 +42,6 @@ std::size_t WorkerThreads(int threads);
 /// is more than the cores (--threads 8 on two cores runs eight), so that a result's independence
 /// of the thread count can be checked on any machine.
 void RunOnWorkerThreads(int threads, const std::function<void()>& work);
-
-/// Seconds since `start` (steady clock).
-double SecondsSince(std::chrono::steady_clock::time_point start);
-
-/// Writes `json` (pretty-printed) to `path` atomically.
-void WriteJson(const std::string& path, const nlohmann::json& json);
 
 /// A half-open scan range "A:B" (either side may be empty: ":100", "50:"), clamped to `count`.
 struct ScanRange {
@@ -82,42 +69,8 @@ void CheckNotReserved(const std::string& option, const std::string& path,
 /// none when `yaml_path` is empty.
 std::vector<std::pair<std::string, std::string>> GridOutputs(const std::string& yaml_path);
 
-/// Writes `grid` as a map_server map at `yaml_path` and prints where, its size and resolution.
-void WriteGrid(const std::string& yaml_path, const OccupancyGrid& grid,
-               const OccupancyGridConfig& config);
-
-/// One line: how well a grid agrees with the corrected-pose grid (slam --grid --truth).
-void PrintGridAgreement(const GridAgreement& agreement);
-nlohmann::json GridAgreementJson(const GridAgreement& agreement);
-
 /// --scans A:B as the scans [A, B) of the file that PrepareLogInputs keeps (clamped to the log
 /// there); nothing when `text` is empty.
 void ApplyScanRange(const std::string& text, LogInputOptions& options);
-
-/// Progress on stderr. On a terminal a bar that rewrites itself ("label  123/456  27 %  ETA 12 s"),
-/// at most a few times a second. Elsewhere (a log file, CI) whole lines: one when the work starts,
-/// one every kProgressLineSeconds and one when it ends ("keyplace: label  456/456  done in 80.1
-/// s"). KEYPLACE_PROGRESS=0 prints nothing, =1 the bar, =lines the lines, wherever stderr goes.
-class Progress {
- public:
-  Progress(std::string label, std::size_t total);
-  void Update(std::size_t done);
-  void Finish();
-
- private:
-  enum class Mode { kOff, kBar, kLines };
-  std::string label_;
-  std::size_t total_;
-  Mode mode_;
-  std::chrono::steady_clock::time_point start_;
-  std::chrono::steady_clock::time_point last_print_;
-  bool started_ = false;
-};
-
-/// Seconds between two progress lines when stderr is not a terminal.
-constexpr double kProgressLineSeconds = 5.0;
-
-/// Progress lines for the stages of PrepareLogInputs (one Progress per stage).
-StageProgress StageProgressBar();
 
 }  // namespace keyplace::cli

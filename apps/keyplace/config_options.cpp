@@ -55,18 +55,4 @@ Config ResolveConfig(const ConfigOptions& options, const std::function<void(Conf
   return builder.Build();  // validated once, after every source
 }
 
-nlohmann::json ConfigJson(const Config& config) {
-  nlohmann::json json = nlohmann::json::object();
-  for (const auto& [key, value] : ConfigKeyValues(config)) {
-    nlohmann::json* node = &json;
-    std::size_t start = 0;
-    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', start)) {
-      node = &(*node)[key.substr(start, dot - start)];
-      start = dot + 1;
-    }
-    (*node)[key.substr(start)] = value;
-  }
-  return json;
-}
-
 }  // namespace keyplace::cli

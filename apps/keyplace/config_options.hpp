@@ -7,8 +7,8 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
+#include "command_output.hpp"
 #include "keyplace/config/config.hpp"
 #include "keyplace/io/carmen_log.hpp"
 
@@ -38,8 +38,5 @@ CarmenReadOptions ReadingOptions(const Config& config, bool skip_bad_lines = fal
 Config ResolveConfig(const ConfigOptions& options,
                      const std::function<void(Config&)>& after_preset = {},
                      const std::vector<std::string>& aliases = {});
-
-/// The whole configuration as nested JSON objects (section -> key -> text value).
-nlohmann::json ConfigJson(const Config& config);
 
 }  // namespace keyplace::cli

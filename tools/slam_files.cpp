@@ -6,7 +6,7 @@
 
 #include <fmt/core.h>
 
-#include "config_options.hpp"
+#include "command_output.hpp"
 #include "eval_json.hpp"
 #include "io/atomic_file.hpp"
 #include "paper_tables.hpp"

@@ -10,7 +10,9 @@
 #include <fmt/core.h>
 #include <tbb/parallel_for.h>
 
-#include "cli_support.hpp"
+#include "command_output.hpp"
+#include "common/seconds_since.hpp"
+#include "progress.hpp"
 
 namespace keyplace::cli {
 

@@ -7,8 +7,9 @@
 #include <fmt/core.h>
 #include <tbb/parallel_for.h>
 
-#include "cli_support.hpp"
+#include "common/seconds_since.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
+#include "progress.hpp"
 
 namespace keyplace::cli {
 
