@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "config/section_tables.hpp"
+#include "io/io_fields.hpp"
 
 namespace keyplace {
 

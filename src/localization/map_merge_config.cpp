@@ -2,8 +2,8 @@
 #include <stdexcept>
 
 #include "common/config_fields.hpp"
-#include "config/section_tables.hpp"
 #include "keyplace/localization/map_merge.hpp"
+#include "localization/localization_fields.hpp"
 
 namespace keyplace {
 

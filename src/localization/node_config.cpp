@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "config/section_tables.hpp"
+#include "localization/localization_fields.hpp"
 
 namespace keyplace {
 namespace {

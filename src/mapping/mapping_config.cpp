@@ -5,7 +5,7 @@
 #include <string>
 
 #include "common/config_fields.hpp"
-#include "config/section_tables.hpp"
+#include "mapping/mapping_fields.hpp"
 
 namespace keyplace {
 namespace {

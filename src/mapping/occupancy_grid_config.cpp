@@ -4,8 +4,8 @@
 #include <string>
 
 #include "common/config_fields.hpp"
-#include "config/section_tables.hpp"
 #include "keyplace/mapping/occupancy_grid.hpp"
+#include "mapping/mapping_fields.hpp"
 
 namespace keyplace {
 

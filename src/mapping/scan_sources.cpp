@@ -11,10 +11,12 @@
 
 #include "common/config_fields.hpp"
 #include "common/seconds_since.hpp"
-#include "config/section_tables.hpp"
+#include "features/features_fields.hpp"
 #include "io/atomic_file.hpp"
+#include "io/io_fields.hpp"
 #include "keyplace_generated/preparation_code_hash.hpp"
 #include "mapping/preparation_cache.hpp"
+#include "registration/registration_fields.hpp"
 
 namespace keyplace {
 

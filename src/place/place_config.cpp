@@ -4,7 +4,7 @@
 #include <string>
 
 #include "common/config_fields.hpp"
-#include "config/section_tables.hpp"
+#include "place/place_fields.hpp"
 
 namespace keyplace {
 namespace {

@@ -1,0 +1,53 @@
+// The field tables of LocalizerConfig and its FixPolicy (docs in global_localizer.hpp).
+
+#include "localization/localization_fields.hpp"
+
+namespace keyplace {
+
+namespace {
+
+const ConfigFields<FixPolicy>& FixPolicyFields() {
+  using C = FixPolicy;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("FixPolicy");
+    table
+        .Int("confirmations", &C::confirmations, "",
+             "accepted answers that must agree through odometry before a fix")
+        .Double("agree_m", &C::agree_m, "m", "two answers agree within this distance (now) ...")
+        .Double("agree_per_m", &C::agree_per_m, "m/m",
+                "... plus this per metre travelled between them (odometry drift)")
+        .Double("agree_deg", &C::agree_deg, "deg", "... and this angle")
+        .Double("window_m", &C::window_m, "m",
+                "answers older than this odometry distance are forgotten while searching")
+        .Double("lost_after_m", &C::lost_after_m, "m",
+                "a fix no answer confirmed over this odometry distance is lost")
+        .Double("contradiction_confidence", &C::contradiction_confidence, "",
+                "one accepted answer this confident contradicting the fix loses it at once")
+        .Double("map_sigma_m", &C::map_sigma_m, "m",
+                "the map's own position error, added to a fix's covariance from the matches")
+        .Double("map_sigma_deg", &C::map_sigma_deg, "deg",
+                "the map's own heading error, added likewise");
+    return table;
+  }();
+  return fields;
+}
+
+}  // namespace
+
+const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
+  using C = LocalizerConfig;
+  static const ConfigFields<C> fields = [] {
+    ConfigFields<C> table("LocalizerConfig");
+    table
+        .Int("max_query_scans", &C::max_query_scans, "",
+             "a query submap not complete after this many scans is recognised as it stands")
+        .Double("query_every_m", &C::query_every_m, "m",
+                "also answer from the query as it stands every time the robot travelled this far "
+                "(0 = only complete queries)")
+        .Nested("fix", &C::fix, FixPolicyFields());
+    return table;
+  }();
+  return fields;
+}
+
+}  // namespace keyplace
