@@ -24,6 +24,8 @@ packages=(
   # the CLI tests read JSON with python3; the Python module's tests and example (Debian's
   # /usr/bin/python3) use numpy and matplotlib
   python3 python3-numpy python3-matplotlib
+  # the Python module's type stubs are checked with mypy's stubtest; pip installs the checkout
+  python3-mypy python3-venv python3-pip
   # tests, benchmarks, style
   libgtest-dev libgmock-dev libbenchmark-dev clang-format clang-tidy
   # make fuzz: clang and its libFuzzer and sanitizer runtimes

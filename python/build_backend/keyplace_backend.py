@@ -29,6 +29,7 @@ import zipfile
 PROJECT_NAME = "keyplace"
 SUMMARY = "2D-LiDAR place recognition (FLIRT keypoints, submaps, global localization)"
 DEPENDENCIES = ["numpy"]
+STUB_PACKAGE = PROJECT_NAME + "-stubs"
 # What the default build folder enables: the module and the library it links, nothing else.
 CONFIGURE_OPTIONS = [
     "-DCMAKE_BUILD_TYPE=Release",
@@ -77,7 +78,10 @@ def prepare_metadata_for_build_editable(metadata_directory, config_settings=None
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
     root = source_root()
     extension = build_extension(root)
-    files = {os.path.basename(extension): read_bytes(extension)}
+    stub = read_bytes(os.path.join(root, "python", "keyplace.pyi"))
+    # The type stubs go where type checkers look for a module's stubs (PEP 561).
+    files = {os.path.basename(extension): read_bytes(extension),
+             STUB_PACKAGE + "/__init__.pyi": stub}
     return write_wheel(wheel_directory, project_version(root), wheel_tag(), files)
 
 
