@@ -17,6 +17,7 @@
 #include "keyplace/io/relations.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "result_fields.hpp"
 
 namespace keyplace::python {
 namespace {
@@ -73,57 +74,25 @@ MapLocalization Localize(const std::string& log_path, const py::object& map,
 }
 
 void BindLocalizationEvaluation(py::module_& module) {
-  py::class_<MapLocalization>(module, "LocalizationEvaluation",
-                              "What `keyplace localize` measures: one record per query (arrays "
-                              "in query order) and the summary figures.")
-      .def_property_readonly(
-          "n_pos", [](const MapLocalization& r) { return r.summary.n_pos; }, "Queries evaluated.")
-      .def_property_readonly(
-          "n_acc", [](const MapLocalization& r) { return r.summary.n_acc; }, "Accepted answers.")
-      .def_property_readonly(
-          "n_cor", [](const MapLocalization& r) { return r.summary.n_cor; },
-          "Correct accepted answers (within evaluation thresholds).")
-      .def_property_readonly(
-          "precision", [](const MapLocalization& r) { return r.summary.precision; },
-          "n_cor / n_acc (0 when nothing was accepted).")
-      .def_property_readonly(
-          "recall", [](const MapLocalization& r) { return r.summary.recall; }, "n_cor / n_pos.")
-      .def_property_readonly(
-          "recall_revisitable",
-          [](const MapLocalization& r) { return r.summary.recall_revisitable; },
-          "Correct answers / queries whose place the map has seen.")
-      .def_property_readonly("n_revisitable",
-                             [](const MapLocalization& r) { return r.summary.n_revisitable; })
-      .def_property_readonly(
-          "p_gl", [](const MapLocalization& r) { return r.summary.p_gl; },
-          "Precision at the maximum recall of the curve.")
-      .def_property_readonly(
-          "p_cl", [](const MapLocalization& r) { return r.summary.p_cl; },
-          "Highest recall at precision >= 0.95.")
-      .def_property_readonly(
-          "scans_mean", [](const MapLocalization& r) { return r.summary.scans_mean; },
-          "Mean scans of the correctly answered queries.")
-      .def_property_readonly(
-          "seconds_per_query_mean",
-          [](const MapLocalization& r) { return r.summary.seconds_per_query_mean; },
-          "Mean recognition time per query (s).")
-      .def_property_readonly(
-          "curve",
-          [](const MapLocalization& r) {
-            py::array_t<double> array(
-                {static_cast<py::ssize_t>(r.summary.curve.size()), py::ssize_t{3}});
-            auto view = array.mutable_unchecked<2>();
-            for (py::ssize_t i = 0; i < view.shape(0); ++i) {
-              const PrPoint& point = r.summary.curve[static_cast<std::size_t>(i)];
-              view(i, 0) = point.threshold;
-              view(i, 1) = point.precision;
-              view(i, 2) = point.recall;
-            }
-            return array;
-          },
-          "N x 3 precision-recall curve rows [threshold, precision, recall].")
-      .def_property_readonly("rank_by",
-                             [](const MapLocalization& r) { return ToString(r.summary.rank_by); })
+  py::class_<MapLocalization> cls(module, "LocalizationEvaluation",
+                                  "What `keyplace localize` measures: one record per query "
+                                  "(arrays in query order) and the summary figures.");
+  DefResultFields(cls, LocalizationSummaryFields(), &MapLocalization::summary);
+  cls.def_property_readonly(
+         "curve",
+         [](const MapLocalization& r) {
+           py::array_t<double> array(
+               {static_cast<py::ssize_t>(r.summary.curve.size()), py::ssize_t{3}});
+           auto view = array.mutable_unchecked<2>();
+           for (py::ssize_t i = 0; i < view.shape(0); ++i) {
+             const PrPoint& point = r.summary.curve[static_cast<std::size_t>(i)];
+             view(i, 0) = point.threshold;
+             view(i, 1) = point.precision;
+             view(i, 2) = point.recall;
+           }
+           return array;
+         },
+         "N x 3 precision-recall curve rows [threshold, precision, recall].")
       .def_readonly("truth_is_map_log", &MapLocalization::truth_is_map_log)
       .def_readonly("places", &MapLocalization::places)
       .def_readonly("seconds_queries", &MapLocalization::seconds_queries)

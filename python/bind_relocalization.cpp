@@ -14,6 +14,7 @@
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
+#include "result_fields.hpp"
 
 namespace keyplace::python {
 namespace {
@@ -126,42 +127,12 @@ void BindRecords(py::module_& module) {
       .def_readonly("update_seconds_max", &StartRecord::update_seconds_max);
 }
 
-// A summary figure as a read-only property named as its key in `keyplace relocalize --json`.
-template <typename Field>
-void Summary(py::class_<PyRelocalization>& cls, const char* name, Field field, const char* doc) {
-  cls.def_property_readonly(
-      name, [field](const PyRelocalization& r) { return r.summary.*field; }, doc);
-}
-
 void BindRelocalizationEvaluation(py::module_& module) {
   py::class_<PyRelocalization> cls(
       module, "RelocalizationEvaluation",
       "What `keyplace relocalize` measures: the summary figures (named as in its --json), one "
       "StartRecord per start, and the first fix.");
-  using S = RelocalizationSummary;
-  Summary(cls, "starts", &S::starts, "Starts run (capped to the scans with a truth pose).");
-  Summary(cls, "starts_with_revisit", &S::starts_with_revisit, "");
-  Summary(cls, "fixed", &S::fixed, "Starts with a first fix.");
-  Summary(cls, "fixed_with_revisit", &S::fixed_with_revisit, "");
-  Summary(cls, "fixed_fraction", &S::fixed_fraction, "fixed_with_revisit / starts_with_revisit.");
-  Summary(cls, "fixes", &S::fixes, "Fixes reported and checked.");
-  Summary(cls, "wrong_fixes", &S::wrong_fixes, "");
-  Summary(cls, "wrong_fix_rate", &S::wrong_fix_rate, "wrong_fixes / fixes.");
-  Summary(cls, "wrong_first_fixes", &S::wrong_first_fixes, "");
-  Summary(cls, "wrong_fix_confident", &S::wrong_fix_confident,
-          "A wrong fix had confidence >= 0.9.");
-  Summary(cls, "wrong_fix_confidence_max", &S::wrong_fix_confidence_max, "");
-  Summary(cls, "distance_to_fix_median_m", &S::distance_to_fix_median_m, "Over fixed starts.");
-  Summary(cls, "distance_to_fix_p90_m", &S::distance_to_fix_p90_m, "");
-  Summary(cls, "scans_to_fix_median", &S::scans_to_fix_median, "");
-  Summary(cls, "distance_after_revisit_median_m", &S::distance_after_revisit_median_m,
-          "From the first scan the map has seen to the first fix.");
-  Summary(cls, "distance_after_revisit_p90_m", &S::distance_after_revisit_p90_m, "");
-  Summary(cls, "update_seconds_mean", &S::update_seconds_mean, "Per update (s).");
-  Summary(cls, "update_seconds_max", &S::update_seconds_max, "");
-  Summary(cls, "lost_signals", &S::lost_signals, "");
-  Summary(cls, "lost_on_correct_track", &S::lost_on_correct_track, "");
-  Summary(cls, "lost_on_wrong_track", &S::lost_on_wrong_track, "");
+  DefResultFields(cls, RelocalizationSummaryFields(), &PyRelocalization::summary);
   cls.def_readonly("config", &PyRelocalization::config,
                    "The keyplace.Config of the run (the CLI's JSON 'config').")
       .def_readonly("keypoint_seconds_per_scan", &PyRelocalization::keypoint_seconds_per_scan)

@@ -8,6 +8,7 @@
 
 #include "io/atomic_file.hpp"
 #include "paper_tables.hpp"
+#include "result_json.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -195,26 +196,11 @@ nlohmann::json LocalizeJson(const LocalizeReport& r,
   json["scans"] = r.log_scans;
   json["skipped_lines"] = r.skipped_lines;
   json["n_pos_requested"] = r.n_requested;
-  json["n_pos"] = s.n_pos;
-  json["n_acc"] = s.n_acc;
-  json["n_cor"] = s.n_cor;
-  json["n_verified"] = s.n_verified;
-  json["n_ambiguous"] = s.n_ambiguous;
-  json["precision"] = s.precision;
-  json["recall"] = s.recall;
-  json["n_revisitable"] = s.n_revisitable;
-  json["recall_revisitable"] = s.recall_revisitable;
   json["revisit_radius_m"] = r.evaluation.revisit_radius_m;
   json["revisit_angle_deg"] = r.evaluation.revisit_angle_deg;
-  json["scans_mean"] = s.scans_mean;
-  json["scans_mean_all_queries"] = s.scans_mean_all_queries;
-  json["seconds_per_query_mean"] = s.seconds_per_query_mean;
-  json["seconds_submap_building_mean"] = s.seconds_submap_building_mean;
   json["seconds_preparation"] = r.preparation_seconds;
   json["preparation_from_cache"] = r.preparation_from_cache;
-  json["rank_by"] = ToString(s.rank_by);
-  json["p_gl"] = s.p_gl;
-  json["p_cl"] = s.p_cl;
+  AddResultFields(s, LocalizationSummaryFields(), json);
   json["curve"] = CurveJson(s.curve);
   json["reliability"] = ReliabilityJson(s.reliability);
   nlohmann::json others;

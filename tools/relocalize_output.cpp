@@ -9,6 +9,7 @@
 
 #include "io/atomic_file.hpp"
 #include "relocalization_figure.hpp"
+#include "result_json.hpp"
 
 namespace keyplace::cli {
 
@@ -108,30 +109,10 @@ nlohmann::json RelocalizeJson(const RelocalizeReport& r) {
   json["exclude_shared_scans"] = o.exclude_shared_scans;
   json["give_up_m"] = o.give_up_m;
   json["follow_m"] = o.follow_m;
-  json["starts"] = s.starts;
-  json["starts_with_revisit"] = s.starts_with_revisit;
-  json["fixed"] = s.fixed;
-  json["fixed_with_revisit"] = s.fixed_with_revisit;
-  json["fixed_fraction"] = s.fixed_fraction;
-  json["fixes"] = s.fixes;
-  json["wrong_fixes"] = s.wrong_fixes;
-  json["wrong_fix_rate"] = s.wrong_fix_rate;
-  json["wrong_first_fixes"] = s.wrong_first_fixes;
-  json["wrong_fix_confident"] = s.wrong_fix_confident;
-  json["wrong_fix_confidence_max"] = s.wrong_fix_confidence_max;
-  json["distance_to_fix_median_m"] = s.distance_to_fix_median_m;
-  json["distance_to_fix_p90_m"] = s.distance_to_fix_p90_m;
-  json["scans_to_fix_median"] = s.scans_to_fix_median;
-  json["distance_after_revisit_median_m"] = s.distance_after_revisit_median_m;
-  json["distance_after_revisit_p90_m"] = s.distance_after_revisit_p90_m;
-  json["update_seconds_mean"] = s.update_seconds_mean;
-  json["update_seconds_max"] = s.update_seconds_max;
+  AddResultFields(s, RelocalizationSummaryFields(), json);
   json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan
                                           ? nlohmann::json(*r.seconds_keypoints_per_scan)
                                           : nlohmann::json(nullptr);
-  json["lost_signals"] = s.lost_signals;
-  json["lost_on_correct_track"] = s.lost_on_correct_track;
-  json["lost_on_wrong_track"] = s.lost_on_wrong_track;
   json["seconds_total"] = r.seconds_total;
   return json;
 }

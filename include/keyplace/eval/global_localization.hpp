@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/common/result_fields.hpp"
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/eval/localization.hpp"
@@ -120,6 +121,10 @@ struct LocalizationSummary {
   std::vector<ReliabilityBin> reliability;  // ReliabilityDiagram
 };
 LocalizationSummary Summarize(const std::vector<LocalizationRecord>& records, RankBy rank_by);
+
+/// The summary's figures (all but the curve and the reliability bins), named as the keys of
+/// `keyplace localize --json` and the attributes of Python's LocalizationEvaluation.
+const ResultFields<LocalizationSummary>& LocalizationSummaryFields();
 
 /// Recognises every query with `recognizer`, skipping the places `rule` calls self-matches. Each
 /// record's `revisitable` is false; MarkRevisitable sets it. The queries are recognised in

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/common/result_fields.hpp"
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/ground_truth.hpp"
 #include "keyplace/localization/global_localizer.hpp"
@@ -107,6 +108,10 @@ struct RelocalizationSummary {
   std::size_t lost_on_correct_track = 0;
   std::size_t lost_on_wrong_track = 0;
 };
+
+/// The summary's figures, named as the keys of `keyplace relocalize --json` and the attributes
+/// of Python's RelocalizationEvaluation.
+const ResultFields<RelocalizationSummary>& RelocalizationSummaryFields();
 
 /// Progress: (starts done, starts in all), called from one thread at a time, counting up.
 using StartProgress = std::function<void(std::size_t, std::size_t)>;
