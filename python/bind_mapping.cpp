@@ -13,6 +13,7 @@
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "result_fields.hpp"
 
 namespace keyplace::python {
 namespace {
@@ -117,24 +118,9 @@ void BindSubmap(py::module_& module) {
 }
 
 void BindStats(py::module_& module) {
-  py::class_<MappingStats>(module, "MappingStats", "The mapping criteria of paper Section 5.1.")
-      .def_readonly("compression", &MappingStats::compression,
-                    "Stable keypoints in the map / keypoints of all scans.")
-      .def_readonly("scans_per_submap", &MappingStats::scans_per_submap)
-      .def_readonly("keypoints_per_submap", &MappingStats::keypoints_per_submap)
-      .def_readonly("distribution", &MappingStats::distribution, "Mean delta.")
-      .def_readonly("submaps", &MappingStats::submaps)
-      .def_readonly("forced_submaps", &MappingStats::forced_submaps)
-      .def_readonly("median_path_m", &MappingStats::median_path_m,
-                    "Median robot path length over a submap's scans.")
-      .def_readonly("max_path_m", &MappingStats::max_path_m)
-      .def_readonly("median_extent_m", &MappingStats::median_extent_m,
-                    "Median largest distance of a submap's pose from its first.")
-      .def_readonly("max_extent_m", &MappingStats::max_extent_m)
-      .def_readonly("path_bound_submaps", &MappingStats::path_bound_submaps,
-                    "Submaps whose path reached mapping.max_path_m.")
-      .def_readonly("stable_keypoints", &MappingStats::stable_keypoints)
-      .def_readonly("source_keypoints", &MappingStats::source_keypoints);
+  py::class_<MappingStats> cls(module, "MappingStats",
+                               "The mapping criteria of paper Section 5.1.");
+  DefResultFields(cls, MappingStatsFields());
 }
 
 void BindMap(py::module_& module) {

@@ -31,4 +31,20 @@ void DefResultFields(py::class_<Holder, Options...>& cls, const ResultFields<Res
   }
 }
 
+/// The same for a bound class that is the result itself.
+template <typename Result, typename... Options>
+void DefResultFields(py::class_<Result, Options...>& cls, const ResultFields<Result>& fields) {
+  for (const ResultField<Result>& field : fields.fields()) {
+    const std::string doc = field.meaning + (field.unit.empty() ? "" : " (" + field.unit + ")");
+    const auto read = field.value;
+    cls.def_property_readonly(
+        field.name.c_str(),
+        [read](const Result& result) -> py::object {
+          return std::visit([](const auto& value) -> py::object { return py::cast(value); },
+                            read(result));
+        },
+        doc.c_str());
+  }
+}
+
 }  // namespace keyplace::python

@@ -10,6 +10,7 @@
 #include "eval_json.hpp"
 #include "io/atomic_file.hpp"
 #include "paper_tables.hpp"
+#include "result_json.hpp"
 #include "slam_output.hpp"
 
 namespace keyplace::cli {
@@ -83,12 +84,7 @@ void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
 void AddMapAndTimeJson(const SlamReport& r, double total_seconds, nlohmann::json& json) {
   const MappingStats& m = r.evaluation.mapping;
   const SlamStats& s = r.run.slam->stats();
-  json["submaps"] = m.submaps;
-  json["compression"] = m.compression;
-  json["scans_per_submap"] = m.scans_per_submap;
-  json["keypoints_per_submap"] = m.keypoints_per_submap;
-  json["distribution"] = m.distribution;
-  json["forced_submaps"] = m.forced_submaps;
+  AddResultFields(m, MappingStatsFields(), json);
   json["seconds_per_submap"] = r.evaluation.seconds_per_submap;
   json["seconds"] = {
       {"keypoints", r.run.seconds_keypoints},   {"slam", r.run.seconds_slam},

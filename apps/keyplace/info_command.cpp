@@ -20,6 +20,7 @@
 #include "keyplace/io/timestamps.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "result_json.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -149,19 +150,7 @@ nlohmann::json DescribeMap(const std::string& path, const GlobalMap& map) {
   json["source_hash"] = map.source_hash;
   json["pose_source"] = map.pose_source;
   json["source_scans"] = map.source_scans;
-  json["submaps"] = stats.submaps;
-  json["forced_submaps"] = stats.forced_submaps;
-  json["stable_keypoints"] = stats.stable_keypoints;
-  json["source_keypoints"] = stats.source_keypoints;
-  json["compression"] = stats.compression;
-  json["scans_per_submap"] = stats.scans_per_submap;
-  json["keypoints_per_submap"] = stats.keypoints_per_submap;
-  json["distribution"] = stats.distribution;
-  json["median_path_m"] = stats.median_path_m;
-  json["max_path_m"] = stats.max_path_m;
-  json["path_bound_submaps"] = stats.path_bound_submaps;
-  json["median_extent_m"] = stats.median_extent_m;
-  json["max_extent_m"] = stats.max_extent_m;
+  AddResultFields(stats, MappingStatsFields(), json);
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   bool first = true;
   for (const auto& submap : map.submaps) {

@@ -19,6 +19,7 @@
 #include "keyplace/store/map_file.hpp"
 #include "map_figure.hpp"
 #include "paper_tables.hpp"
+#include "result_json.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -119,19 +120,7 @@ nlohmann::json MapJson(const MapOptions& options, const LogInputs& inputs, const
   json["first_scan"] = inputs.first_scan;
   json["scans_in_log"] = inputs.file_scans;
   json["skipped_lines"] = inputs.log.skipped_lines;
-  json["compression"] = stats.compression;
-  json["scans_per_submap"] = stats.scans_per_submap;
-  json["keypoints_per_submap"] = stats.keypoints_per_submap;
-  json["distribution"] = stats.distribution;
-  json["submaps"] = stats.submaps;
-  json["forced_submaps"] = stats.forced_submaps;
-  json["median_path_m"] = stats.median_path_m;
-  json["max_path_m"] = stats.max_path_m;
-  json["path_bound_submaps"] = stats.path_bound_submaps;
-  json["median_extent_m"] = stats.median_extent_m;
-  json["max_extent_m"] = stats.max_extent_m;
-  json["stable_keypoints"] = stats.stable_keypoints;
-  json["source_keypoints"] = stats.source_keypoints;
+  AddResultFields(stats, MappingStatsFields(), json);
   json["seconds_per_submap"] = result.seconds_per_submap;
   json["seconds_per_submap_mapping_only"] = result.seconds_per_submap_mapping;
   json["seconds_poses"] = inputs.seconds_poses;

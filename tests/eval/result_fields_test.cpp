@@ -4,45 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <set>
 #include <string>
 #include <variant>
 
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/relocalization.hpp"
+#include "support/result_fields_checks.hpp"
 
 namespace keyplace {
 namespace {
-
-// Names unique; a name with a unit suffix has that unit and a unit has its suffix in the name;
-// every figure reads a different member (each member below holds a different value).
-template <typename Result>
-ResultValue ValueOf(const ResultFields<Result>& fields, const Result& result,
-                    const std::string& name) {
-  for (const ResultField<Result>& field : fields.fields()) {
-    if (field.name == name) return field.value(result);
-  }
-  ADD_FAILURE() << "no figure " << name;
-  return ResultValue{};
-}
-
-template <typename Result>
-void ExpectWellFormed(const ResultFields<Result>& fields, const Result& distinct) {
-  std::set<std::string> names;
-  std::set<ResultValue> values;
-  for (const ResultField<Result>& field : fields.fields()) {
-    EXPECT_TRUE(names.insert(field.name).second) << field.name << " twice";
-    EXPECT_FALSE(field.meaning.empty()) << field.name;
-    const auto ends_with = [&](const std::string& suffix) {
-      return field.name.size() > suffix.size() &&
-             field.name.compare(field.name.size() - suffix.size(), suffix.size(), suffix) == 0;
-    };
-    EXPECT_EQ(field.unit == "m", ends_with("_m")) << field.name;
-    EXPECT_EQ(field.unit == "s", field.name.find("seconds") != std::string::npos) << field.name;
-    EXPECT_TRUE(values.insert(field.value(distinct)).second)
-        << field.name << " reads a member another figure reads too";
-  }
-}
 
 TEST(ResultFields, RelocalizationSummaryFiguresReadTheirOwnMembers) {
   RelocalizationSummary s;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "keyplace/common/result_fields.hpp"
 #include "keyplace/mapping/mapping_config.hpp"
 #include "keyplace/mapping/submap.hpp"
 
@@ -50,6 +51,10 @@ struct MappingStats {
 };
 
 MappingStats ComputeStats(const GlobalMap& map);
+
+/// The mapping criteria's figures (all but the configuration), named as the keys of the JSON of
+/// `keyplace map`, `info` and `slam` and the attributes of Python's MappingStats.
+const ResultFields<MappingStats>& MappingStatsFields();
 
 /// Path length of the robot over a submap's poses, and the largest distance of one of its robot
 /// positions from the first (its extent).
