@@ -13,38 +13,36 @@ namespace keyplace::python {
 
 namespace py = pybind11;
 
-/// One property per figure of `fields`, read from the Result held at `member` of the bound
-/// class; the docstring is the figure's meaning and unit.
-template <typename Holder, typename Result, typename... Options>
-void DefResultFields(py::class_<Holder, Options...>& cls, const ResultFields<Result>& fields,
-                     Result Holder::*member) {
+/// One property per figure of `fields`, read from the Result that `result_of` finds in an
+/// instance of the bound class; the docstring is the figure's meaning and unit.
+template <typename Holder, typename Result, typename ResultOf, typename... Options>
+void DefResultFieldsOf(py::class_<Holder, Options...>& cls, const ResultFields<Result>& fields,
+                       ResultOf result_of) {
   for (const ResultField<Result>& field : fields.fields()) {
     const std::string doc = field.meaning + (field.unit.empty() ? "" : " (" + field.unit + ")");
     const auto read = field.value;
     cls.def_property_readonly(
         field.name.c_str(),
-        [read, member](const Holder& holder) -> py::object {
+        [read, result_of](const Holder& holder) -> py::object {
           return std::visit([](const auto& value) -> py::object { return py::cast(value); },
-                            read(holder.*member));
+                            read(result_of(holder)));
         },
         doc.c_str());
   }
 }
 
-/// The same for a bound class that is the result itself.
+/// For a bound class holding the Result at `member`.
+template <typename Holder, typename Result, typename... Options>
+void DefResultFields(py::class_<Holder, Options...>& cls, const ResultFields<Result>& fields,
+                     Result Holder::*member) {
+  DefResultFieldsOf(cls, fields,
+                    [member](const Holder& holder) -> const Result& { return holder.*member; });
+}
+
+/// For a bound class that is the Result itself.
 template <typename Result, typename... Options>
 void DefResultFields(py::class_<Result, Options...>& cls, const ResultFields<Result>& fields) {
-  for (const ResultField<Result>& field : fields.fields()) {
-    const std::string doc = field.meaning + (field.unit.empty() ? "" : " (" + field.unit + ")");
-    const auto read = field.value;
-    cls.def_property_readonly(
-        field.name.c_str(),
-        [read](const Result& result) -> py::object {
-          return std::visit([](const auto& value) -> py::object { return py::cast(value); },
-                            read(result));
-        },
-        doc.c_str());
-  }
+  DefResultFieldsOf(cls, fields, [](const Result& result) -> const Result& { return result; });
 }
 
 }  // namespace keyplace::python
