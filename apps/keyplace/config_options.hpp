@@ -8,7 +8,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "command_output.hpp"
 #include "keyplace/config/config.hpp"
 #include "keyplace/io/carmen_log.hpp"
 
