@@ -78,6 +78,44 @@ class WheelWriter(unittest.TestCase):
             self.assertEqual(a.read(), b.read())
 
 
+class BuildWheel(unittest.TestCase):
+    """build_wheel, the hook pip calls, with the CMake build replaced by a file of ours: what it
+    puts in the wheel, and where."""
+
+    def test_wheel_holds_the_built_extension_and_the_stubs_as_a_stub_package(self):
+        with tempfile.TemporaryDirectory() as folder:
+            extension = os.path.join(folder, FAKE_EXTENSION)
+            with open(extension, "wb") as out:
+                out.write(b"\x7fELF the extension CMake built")
+            built = []
+
+            def fake_build(root):
+                built.append(root)
+                return extension
+
+            real_build, real_cwd = keyplace_backend.build_extension, os.getcwd()
+            keyplace_backend.build_extension = fake_build
+            try:
+                os.chdir(SOURCE_DIR)  # PEP 517 runs hooks in the checkout
+                name = keyplace_backend.build_wheel(os.path.join(folder, "wheels"))
+            finally:
+                keyplace_backend.build_extension = real_build
+                os.chdir(real_cwd)
+            with zipfile.ZipFile(os.path.join(folder, "wheels", name)) as wheel:
+                contents = {path: wheel.read(path) for path in wheel.namelist()}
+        version = keyplace_backend.project_version(SOURCE_DIR)
+        dist_info = f"keyplace-{version}.dist-info"
+        self.assertEqual(len(built), 1)
+        self.assertEqual(os.path.realpath(built[0]), os.path.realpath(SOURCE_DIR))
+        self.assertEqual(set(contents), {FAKE_EXTENSION, "keyplace-stubs/__init__.pyi",
+                                         f"{dist_info}/METADATA", f"{dist_info}/WHEEL",
+                                         f"{dist_info}/RECORD"})
+        self.assertEqual(contents[FAKE_EXTENSION], b"\x7fELF the extension CMake built")
+        with open(os.path.join(SOURCE_DIR, "python", "keyplace.pyi"), "rb") as stub:
+            self.assertEqual(contents["keyplace-stubs/__init__.pyi"], stub.read())
+        self.assertIn("Requires-Dist: numpy", contents[f"{dist_info}/METADATA"].decode())
+
+
 class ProjectFacts(unittest.TestCase):
     def test_version_is_the_one_the_module_reports(self):
         import keyplace  # the module of this build (PYTHONPATH), built with PROJECT_VERSION
