@@ -157,8 +157,8 @@ void BindLocalizationEvaluation(py::module_& module) {
 }
 
 void BindSlam(py::module_& module) {
-  py::class_<SlamRun>(module, "SlamRun", "A finished SLAM run on a log.")
-      .def_readonly("map", &SlamRun::map, "The SLAM map (pose_source 'slam').")
+  py::class_<SlamRun> slam_run(module, "SlamRun", "A finished SLAM run on a log.");
+  slam_run.def_readonly("map", &SlamRun::map, "The SLAM map (pose_source 'slam').")
       .def_property_readonly(
           "poses",
           [](const SlamRun& run) {
@@ -182,47 +182,13 @@ void BindSlam(py::module_& module) {
             for (const auto& pose : run.trajectory) indices.push_back(pose.scan_index);
             return VectorArray(indices);
           },
-          "Log scan (index of the scans given) of each trajectory row.")
-      .def_property_readonly(
-          "loops_detected", [](const SlamRun& run) { return run.slam->loops().size(); },
-          "Loops place recognition detected (accepted or not).")
-      .def_property_readonly("loops_accepted",
-                             [](const SlamRun& run) { return run.slam->stats().loops_accepted; })
-      .def_readonly("seconds_slam", &SlamRun::seconds_slam);
+          "Log scan (index of the scans given) of each trajectory row.");
+  DefResultFields(slam_run, SlamRunFields());
 
-  py::class_<SlamEvaluation>(module, "SlamEvaluation", "The evaluation of a SLAM run.")
-      .def_readonly("has_truth", &SlamEvaluation::has_truth)
+  py::class_<SlamEvaluation> evaluation(module, "SlamEvaluation", "The evaluation of a SLAM run.");
+  DefResultFields(evaluation, SlamEvaluationFields());
+  evaluation.def_readonly("has_truth", &SlamEvaluation::has_truth)
       .def_readonly("mapping", &SlamEvaluation::mapping, "MappingStats of the SLAM map.")
-      .def_property_readonly("loops_truth_correct",
-                             [](const SlamEvaluation& e) { return e.loops.truth_correct; })
-      .def_property_readonly("loops_truth_evaluated",
-                             [](const SlamEvaluation& e) { return e.loops.truth_evaluated; })
-      .def_property_readonly(
-          "loop_precision_overlap_30",
-          [](const SlamEvaluation& e) -> py::object {
-            if (e.loops.overlap.empty()) return py::none();  // no loops: no share
-            return py::float_(e.precision.overlap_30);
-          },
-          "Share of detected loops whose submaps overlap by >= 30 % (None without loops).")
-      .def_property_readonly(
-          "ate_rmse_m",
-          [](const SlamEvaluation& e) -> py::object {
-            if (!e.accuracy) return py::none();
-            return py::float_(e.accuracy->ate.translation_rmse_m);
-          },
-          "ATE translation RMSE after SE(2) alignment (m); None without truth.")
-      .def_property_readonly("ate_rotation_rmse_deg",
-                             [](const SlamEvaluation& e) -> py::object {
-                               if (!e.accuracy) return py::none();
-                               return py::float_(e.accuracy->ate.rotation_rmse_deg);
-                             })
-      .def_property_readonly(
-          "ate_icp_rmse_m",
-          [](const SlamEvaluation& e) -> py::object {
-            if (!e.accuracy) return py::none();
-            return py::float_(e.accuracy->ate_icp.translation_rmse_m);
-          },
-          "The same for the ICP odometry alone.")
       .def_property_readonly(
           "rpe",
           [](const SlamEvaluation& e) -> py::object {

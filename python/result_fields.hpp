@@ -3,6 +3,7 @@
 // (keyplace/common/result_fields.hpp): the same names as the command's --json keys.
 
 #include <string>
+#include <type_traits>
 #include <variant>
 
 #include <pybind11/pybind11.h>
@@ -14,7 +15,8 @@ namespace keyplace::python {
 namespace py = pybind11;
 
 /// One property per figure of `fields`, read from the Result that `result_of` finds in an
-/// instance of the bound class; the docstring is the figure's meaning and unit.
+/// instance of the bound class (None for a missing figure); the docstring is the figure's meaning
+/// and unit.
 template <typename Holder, typename Result, typename ResultOf, typename... Options>
 void DefResultFieldsOf(py::class_<Holder, Options...>& cls, const ResultFields<Result>& fields,
                        ResultOf result_of) {
@@ -24,8 +26,15 @@ void DefResultFieldsOf(py::class_<Holder, Options...>& cls, const ResultFields<R
     cls.def_property_readonly(
         field.name.c_str(),
         [read, result_of](const Holder& holder) -> py::object {
-          return std::visit([](const auto& value) -> py::object { return py::cast(value); },
-                            read(result_of(holder)));
+          return std::visit(
+              [](const auto& value) -> py::object {
+                if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::monostate>) {
+                  return py::none();
+                } else {
+                  return py::cast(value);
+                }
+              },
+              read(result_of(holder)));
         },
         doc.c_str());
   }

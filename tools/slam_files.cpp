@@ -18,44 +18,14 @@ namespace {
 
 double Deg(double rad) { return rad * 180.0 / M_PI; }
 
-void AddLoopJson(const SlamReport& r, nlohmann::json& json) {
-  const SlamStats& s = r.run.slam->stats();
-  const SlamEvaluation& e = r.evaluation;
-  const LoopPrecisions& p = e.precision;
-  json["queries"] = s.queries;
-  json["loops_detected"] = r.run.slam->loops().size();
-  json["loops_accepted"] = s.loops_accepted;
-  json["loops_used"] = e.loops.used_count;
-  json["loops_refined"] = s.loops_refined;
-  json["loops_partner_changed"] = s.loops_partner_changed;
-  json["loops_rejected_by_point_overlap"] = s.loops_rejected_by_point_overlap;
-  json["precision_overlap_30_matched_ransac"] = p.matched_ransac_30;
-  json["optimizations"] = s.optimizations;
-  json["ceres_solves"] = s.solves;
-  json["precision_overlap_10"] = p.overlap_10;
-  json["precision_overlap_30"] = p.overlap_30;
-  json["precision_overlap_30_used"] = p.used_overlap_30;
-  json["precision_overlap_30_cells_0_2m"] = p.cells_0_2m_30;
-  json["precision_overlap_10_cells_0_2m"] = p.cells_0_2m_10;
-  json["loops_below_1_percent_overlap"] = e.loops_below_1_percent;
-  json["precision_overlap_10_common_area"] = p.common_area_10;
-  json["precision_overlap_30_common_area"] = p.common_area_30;
+// The overlap histograms; the figures are SlamRunFields() and SlamEvaluationFields().
+void AddHistogramJson(const SlamEvaluation& e, nlohmann::json& json) {
   json["overlap_histogram_common_area"] = e.histogram_common.counts;
   json["overlap_histogram"] = e.histogram.counts;
-  // A share of no loops is not 0 (issue 17): without loops every precision is null.
-  if (r.run.slam->loops().empty()) {
-    for (auto& [key, value] : json.items()) {
-      if (key.rfind("precision_", 0) == 0) value = nullptr;
-    }
-  }
-  if (e.loops.used_count == 0) json["precision_overlap_30_used"] = nullptr;
 }
 
 void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
   const LoopEvaluation& ev = e.loops;
-  json["loops_truth_evaluated"] = ev.truth_evaluated;
-  json["loops_truth_correct"] = ev.truth_correct;
-  json["loops_truth_max_gap_scans"] = e.truth_max_gap_scans;
   nlohmann::json tests = nlohmann::json::array();
   for (const OverlapTest& t : ev.overlap_tests) {
     tests.push_back({{"threshold", t.threshold},
@@ -72,25 +42,11 @@ void AddLoopTruthJson(const SlamEvaluation& e, nlohmann::json& json) {
                               {"rotation_mean_deg", ev.paired_final_deg},
                               {"ransac_translation_mean_m", ev.paired_ransac_m},
                               {"ransac_rotation_mean_deg", ev.paired_ransac_deg}};
-  json["precision_truth"] = ev.precision_truth();
-  if (ev.truth_evaluated == 0) json["precision_truth"] = nullptr;
   if (ev.paired_loops == 0) {
     for (auto& [key, value] : json["loop_truth_error"].items()) {
       if (key != "loops") value = nullptr;
     }
   }
-}
-
-void AddMapAndTimeJson(const SlamReport& r, double total_seconds, nlohmann::json& json) {
-  const MappingStats& m = r.evaluation.mapping;
-  const SlamStats& s = r.run.slam->stats();
-  AddResultFields(m, MappingStatsFields(), json);
-  json["seconds_per_submap"] = r.evaluation.seconds_per_submap;
-  json["seconds"] = {
-      {"keypoints", r.run.seconds_keypoints},   {"slam", r.run.seconds_slam},
-      {"odometry", s.seconds_odometry},         {"mapping", s.seconds_mapping},
-      {"recognition", s.seconds_recognition},   {"loop_refinement", s.seconds_loop_refinement},
-      {"optimization", s.seconds_optimization}, {"total", total_seconds}};
 }
 
 nlohmann::json PaperJson(const PaperSlamRow& paper) {
@@ -106,12 +62,7 @@ nlohmann::json PaperJson(const PaperSlamRow& paper) {
           {"precision_overlap_10", paper.precision_overlap_10}};
 }
 
-void AddAccuracyJson(const SlamAccuracy& a, nlohmann::json& json) {
-  json["ate_rmse_m"] = a.ate.translation_rmse_m;
-  json["ate_rotation_rmse_deg"] = a.ate.rotation_rmse_deg;
-  json["ate_icp_rmse_m"] = a.ate_icp.translation_rmse_m;
-  json["ate_icp_rotation_rmse_deg"] = a.ate_icp.rotation_rmse_deg;
-  json["truth_pairs"] = a.truth_pairs;
+void AddRpeJson(const SlamAccuracy& a, nlohmann::json& json) {
   nlohmann::json rpe = nlohmann::json::array();
   for (const RpePoint& p : a.rpe) {
     rpe.push_back({{"delta", p.delta},
@@ -129,15 +80,17 @@ nlohmann::json SlamJson(const SlamReport& r, double total_seconds) {
   json["log"] = r.log_path;
   json["dataset"] = r.dataset ? *r.dataset : "";
   json["order"] = ToString(r.run.order);
-  json["scans"] = r.run.scans;
-  AddLoopJson(r, json);
+  AddResultFields(r.run, SlamRunFields(), json);
+  AddResultFields(r.evaluation, SlamEvaluationFields(), json);
+  AddResultFields(r.evaluation.mapping, MappingStatsFields(), json);
+  json["seconds_total"] = total_seconds;
+  AddHistogramJson(r.evaluation, json);
   if (r.evaluation.has_truth) AddLoopTruthJson(r.evaluation, json);
-  AddMapAndTimeJson(r, total_seconds, json);
   json["config"] = ConfigJson(r.config);
   if (const PaperSlamRow* paper = r.dataset ? PaperSlam(*r.dataset) : nullptr) {
     json["paper"] = PaperJson(*paper);
   }
-  if (r.evaluation.accuracy) AddAccuracyJson(*r.evaluation.accuracy, json);
+  if (r.evaluation.accuracy) AddRpeJson(*r.evaluation.accuracy, json);
   if (r.evaluation.relations) json["relations"] = RelationJson(*r.evaluation.relations);
   if (r.evaluation.relations_icp) json["relations_icp"] = RelationJson(*r.evaluation.relations_icp);
   return json;

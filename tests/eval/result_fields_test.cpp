@@ -9,6 +9,7 @@
 
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/relocalization.hpp"
+#include "keyplace/eval/slam_evaluation.hpp"
 #include "support/result_fields_checks.hpp"
 
 namespace keyplace {
@@ -71,6 +72,62 @@ TEST(ResultFields, LocalizationSummaryFiguresReadTheirOwnMembers) {
   EXPECT_EQ(ValueOf(fields, s, "n_cor"), ResultValue(std::int64_t{3}));
   EXPECT_EQ(ValueOf(fields, s, "p_cl"), ResultValue(0.375));
   EXPECT_EQ(ValueOf(fields, s, "rank_by"), ResultValue(std::string("gamma")));
+}
+
+// A SLAM evaluation with loops, ground truth and an ATE alignment, each figure a different value.
+SlamEvaluation DistinctSlamEvaluation() {
+  SlamEvaluation e;
+  e.loops.overlap = {0.9, 0.1};
+  e.loops.used_count = 1;
+  e.loops.truth_evaluated = 4;
+  e.loops.truth_correct = 3;  // precision_truth 0.75
+  e.precision = {0.11, 0.12, 0.13, 0.14, 0.15, 0.16, 0.17, 0.18};
+  e.loops_below_1_percent = 2;
+  e.seconds_per_submap = 0.5;
+  e.has_truth = true;
+  e.truth_max_gap_scans = 5;
+  SlamAccuracy accuracy;
+  accuracy.truth_pairs = 6;
+  accuracy.ate.translation_rmse_m = 0.21;
+  accuracy.ate.rotation_rmse_deg = 0.22;
+  accuracy.ate_icp.translation_rmse_m = 0.23;
+  accuracy.ate_icp.rotation_rmse_deg = 0.24;
+  e.accuracy = accuracy;
+  return e;
+}
+
+TEST(ResultFields, SlamEvaluationFiguresReadTheirOwnMembers) {
+  const SlamEvaluation e = DistinctSlamEvaluation();
+  const ResultFields<SlamEvaluation>& fields = SlamEvaluationFields();
+  ExpectWellFormed(fields, e);
+  EXPECT_EQ(fields.fields().size(), 20u);
+  EXPECT_EQ(ValueOf(fields, e, "precision_overlap_30_used"), ResultValue(0.13));
+  EXPECT_EQ(ValueOf(fields, e, "precision_overlap_30_matched_ransac"), ResultValue(0.18));
+  EXPECT_EQ(ValueOf(fields, e, "precision_truth"), ResultValue(0.75));
+  EXPECT_EQ(ValueOf(fields, e, "ate_icp_rmse_m"), ResultValue(0.23));
+  EXPECT_EQ(ValueOf(fields, e, "loops_truth_max_gap_scans"), ResultValue(std::int64_t{5}));
+}
+
+// A share of no loops, a figure against absent truth: missing (JSON null, Python None), not 0.
+TEST(ResultFields, SlamEvaluationFiguresAreMissingWithoutLoopsOrTruth) {
+  SlamEvaluation e = DistinctSlamEvaluation();
+  e.loops.overlap.clear();
+  e.loops.used_count = 0;
+  e.has_truth = false;
+  e.accuracy.reset();
+  const ResultFields<SlamEvaluation>& fields = SlamEvaluationFields();
+  for (const char* name :
+       {"precision_overlap_10", "precision_overlap_30_used", "precision_overlap_30_common_area",
+        "loops_truth_correct", "precision_truth", "truth_pairs", "ate_rmse_m"}) {
+    EXPECT_TRUE(std::holds_alternative<std::monostate>(ValueOf(fields, e, name))) << name;
+  }
+  EXPECT_EQ(ValueOf(fields, e, "loops_used"), ResultValue(std::int64_t{0}));
+  EXPECT_EQ(ValueOf(fields, e, "seconds_per_submap"), ResultValue(0.5));
+
+  e = DistinctSlamEvaluation();
+  e.loops.truth_evaluated = 0;  // truth, but no loop near a corrected scan
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(ValueOf(fields, e, "precision_truth")));
+  EXPECT_EQ(ValueOf(fields, e, "loops_truth_evaluated"), ResultValue(std::int64_t{0}));
 }
 
 }  // namespace

@@ -38,6 +38,20 @@ class SlamTest(unittest.TestCase):
             cli = json.load(stream)
         self.assertEqual(self.slam_run.loops_detected, cli["loops_detected"])
         self.assertEqual(self.slam_run.map.submap_count, cli["submaps"])
+        # The figures come from one table on both sides: same names, same values (the CLI does
+        # not take a corrected log as its own truth, so the truth figures are null there).
+        run_figures = [name for name in cli if hasattr(self.slam_run, name)]
+        self.assertIn("loops_rejected_by_point_overlap", run_figures)
+        for name in run_figures:
+            if "seconds" not in name:
+                self.assertEqual(getattr(self.slam_run, name), cli[name], name)
+        loop_figures = [name for name in cli
+                        if name.startswith(("precision_overlap", "loops_used", "loops_below"))]
+        self.assertEqual(len(loop_figures), 10)
+        for name in loop_figures:
+            self.assertEqual(getattr(self.evaluation, name), cli[name], name)
+        self.assertIsNone(cli["ate_rmse_m"])
+        self.assertIsNotNone(self.evaluation.ate_rmse_m)
 
     def test_the_corrected_log_is_its_own_truth(self):
         # The ATE recomputed here: the corrected poses of the scans, the SLAM positions aligned to

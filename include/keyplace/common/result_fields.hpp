@@ -15,8 +15,10 @@
 
 namespace keyplace {
 
-/// A figure's value: a switch, a count, a measurement or a text.
-using ResultValue = std::variant<bool, std::int64_t, double, std::string>;
+/// A figure's value: a switch, a count, a measurement or a text; std::monostate where the result
+/// has no such figure (no loops, so no loop precision; no ground truth, so no ATE): JSON null,
+/// Python None. A share of nothing is missing, not 0.
+using ResultValue = std::variant<std::monostate, bool, std::int64_t, double, std::string>;
 
 template <typename Result>
 struct ResultField {
@@ -48,7 +50,7 @@ class ResultFields {
     return Add(name, "", meaning,
                [member](const Result& result) -> ResultValue { return result.*member; });
   }
-  /// A figure computed from the struct rather than stored in it.
+  /// A figure computed from the struct rather than stored in it (ResultValue{} when missing).
   ResultFields& Add(const char* name, const char* unit, const char* meaning,
                     std::function<ResultValue(const Result&)> value) {
     fields_.push_back({name, unit, meaning, std::move(value)});

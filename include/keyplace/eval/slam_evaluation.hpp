@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "keyplace/common/result_fields.hpp"
 #include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/grid_agreement.hpp"
 #include "keyplace/eval/ground_truth.hpp"
@@ -113,6 +114,12 @@ struct SlamEvaluation {
   std::optional<RelationErrorReport> relations_icp;  // ... and ICP odometry
   SlamFigurePoints figure;
 };
+
+/// The figures of a run and of its evaluation: the keys of `keyplace slam --json` and the
+/// properties of Python's SlamRun / SlamEvaluation. A loop precision is missing without loops, a
+/// figure against ground truth without truth.
+const ResultFields<SlamRun>& SlamRunFields();
+const ResultFields<SlamEvaluation>& SlamEvaluationFields();
 
 /// Evaluates `run`. `truth` (may be null): the ground truth of the log's scans (indexed like
 /// inputs.log.scans); `relations` (may be null): relations to evaluate by timestamp.
