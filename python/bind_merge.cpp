@@ -8,6 +8,7 @@
 
 #include "bindings.hpp"
 #include "keyplace/localization/map_merge.hpp"
+#include "result_fields.hpp"
 
 namespace keyplace::python {
 namespace {
@@ -30,16 +31,13 @@ py::object MergeMapsOf(const py::object& a, const py::object& b, const py::objec
 }
 
 void BindRecognition(py::module_& module) {
-  py::class_<SubmapRecognition>(module, "SubmapRecognition",
-                                "One submap of B recognised in A (an accepted answer).")
-      .def_readonly("submap_b", &SubmapRecognition::submap_b, "Id of the B submap (in B).")
-      .def_readonly("submap_a", &SubmapRecognition::submap_a, "Id of the A submap it matched.")
-      .def_readonly("confidence", &SubmapRecognition::confidence, "In [0, 1].")
+  py::class_<SubmapRecognition> recognition(
+      module, "SubmapRecognition", "One submap of B recognised in A (an accepted answer).");
+  DefResultFields(recognition, SubmapRecognitionFields());
+  recognition
       .def_property_readonly(
           "T_a_b", [](const SubmapRecognition& r) { return PoseArray(r.T_a_b); },
           "B's frame in A's frame [x_m, y_m, theta_rad] as this recognition alone says.")
-      .def_readonly("agrees", &SubmapRecognition::agrees,
-                    "In the largest agreeing group (the one the transform was fitted to).")
       .def("__repr__", [](const SubmapRecognition& r) {
         return "<keyplace.SubmapRecognition B " + std::to_string(r.submap_b) + " in A " +
                std::to_string(r.submap_a) + (r.agrees ? ", agrees>" : ", disagrees>");
@@ -48,9 +46,11 @@ void BindRecognition(py::module_& module) {
 
 void BindMergeResult(py::module_& module) {
   // dynamic_attr: merge_maps sets `config`, the keyplace.Config it merged with.
-  py::class_<MergeResult>(module, "MergeResult", py::dynamic_attr(),
-                          "Where map B lies in map A, and the two joined; `config` is the "
-                          "keyplace.Config used (the CLI JSON's 'config').")
+  py::class_<MergeResult> result(module, "MergeResult", py::dynamic_attr(),
+                                 "Where map B lies in map A, and the two joined; `config` is the "
+                                 "keyplace.Config used (the CLI JSON's 'config').");
+  DefResultFields(result, MergeResultFields());
+  result
       .def_property_readonly(
           "T_a_b", [](const MergeResult& r) { return PoseArray(r.T_a_b); },
           "B's frame in A's frame [x_m, y_m, theta_rad]: a point p_b of B is T_a_b * p_b in A; "
@@ -58,13 +58,6 @@ void BindMergeResult(py::module_& module) {
       .def_readonly("merged", &MergeResult::merged,
                     "The merged Map in A's frame: A's submaps, then B's moved by T_a_b (ids from "
                     "the second thousand after A's last, scan numbers after A's).")
-      .def_readonly("queried", &MergeResult::queried,
-                    "B submaps with keypoints, each recognised in A ('submaps_queried').")
-      .def_property_readonly(
-          "recognised", [](const MergeResult& r) { return r.recognitions.size(); },
-          "B submaps recognised in A (accepted answers).")
-      .def_readonly("agreeing", &MergeResult::agreeing,
-                    "Recognitions in the largest group agreeing on T_a_b.")
       .def_readonly("recognitions", &MergeResult::recognitions,
                     "The accepted recognitions (list of SubmapRecognition), in B's map order.")
       .def("__repr__", [](const MergeResult& r) {

@@ -20,6 +20,7 @@
 #include "keyplace/eval/merge_evaluation.hpp"
 #include "keyplace/localization/map_merge.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "result_json.hpp"
 
 namespace keyplace::cli {
 namespace {
@@ -123,19 +124,13 @@ nlohmann::json MergeJson(const MergeCommandOptions& options, const MergeResult& 
   json["map_b"] = options.map_b;
   json["T_a_b"] = {
       {"x_m", result.T_a_b.x}, {"y_m", result.T_a_b.y}, {"theta_rad", result.T_a_b.theta}};
-  json["submaps_queried"] = result.queried;
-  json["recognised"] = result.recognitions.size();
-  json["agreeing"] = result.agreeing;
-  json["submaps_merged"] = result.merged.submaps.size();
+  AddResultFields(result, MergeResultFields(), json);
   nlohmann::json recognitions = nlohmann::json::array();
   for (const SubmapRecognition& r : result.recognitions) {
-    recognitions.push_back({{"submap_b", r.submap_b},
-                            {"submap_a", r.submap_a},
-                            {"confidence", r.confidence},
-                            {"agrees", r.agrees},
-                            {"x_m", r.T_a_b.x},
-                            {"y_m", r.T_a_b.y},
-                            {"theta_rad", r.T_a_b.theta}});
+    nlohmann::json recognition = {
+        {"x_m", r.T_a_b.x}, {"y_m", r.T_a_b.y}, {"theta_rad", r.T_a_b.theta}};
+    AddResultFields(r, SubmapRecognitionFields(), recognition);
+    recognitions.push_back(recognition);
   }
   json["recognitions"] = recognitions;
   return json;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,7 @@
 #include "keyplace/localization/map_merge.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 #include "support/bundled_map.hpp"
+#include "support/result_fields_checks.hpp"
 #include "support/test_data.hpp"
 
 namespace keyplace {
@@ -107,6 +109,26 @@ TEST(MapMerge, TwoBuildingsAreRefusedWithTheReason) {
     EXPECT_NE(std::string(error.what()).find("mapping.cell_size_m"), std::string::npos)
         << error.what();
   }
+}
+
+TEST(MergeResultFields, EachFigureReadsItsOwnMember) {
+  MergeResult result;
+  result.queried = 7;
+  result.recognitions.resize(5);
+  result.agreeing = 3;
+  result.merged.submaps.resize(11);
+  ExpectWellFormed(MergeResultFields(), result);
+  EXPECT_EQ(ValueOf(MergeResultFields(), result, "recognised"), ResultValue(std::int64_t{5}));
+  EXPECT_EQ(ValueOf(MergeResultFields(), result, "submaps_merged"), ResultValue(std::int64_t{11}));
+
+  SubmapRecognition recognition;
+  recognition.submap_b = 2;
+  recognition.submap_a = 4;
+  recognition.confidence = 0.5;
+  recognition.agrees = true;
+  ExpectWellFormed(SubmapRecognitionFields(), recognition);
+  EXPECT_EQ(ValueOf(SubmapRecognitionFields(), recognition, "submap_a"),
+            ResultValue(std::int64_t{4}));
 }
 
 }  // namespace

@@ -41,11 +41,12 @@ class MergeTest(unittest.TestCase):
         transform = self.cli["T_a_b"]
         np.testing.assert_array_equal(
             self.result.T_a_b, [transform["x_m"], transform["y_m"], transform["theta_rad"]])
-        self.assertEqual(self.result.queried, self.cli["submaps_queried"])
+        self.assertEqual(self.result.submaps_queried, self.cli["submaps_queried"])
         self.assertEqual(self.result.recognised, self.cli["recognised"])
         self.assertEqual(self.result.agreeing, self.cli["agreeing"])
         self.assertGreaterEqual(self.result.agreeing, 3)
         self.assertEqual(self.result.merged.submap_count, self.cli["submaps_merged"])
+        self.assertEqual(self.result.submaps_merged, self.cli["submaps_merged"])
         self.assertEqual(len(self.result.recognitions), len(self.cli["recognitions"]))
         # The same configuration, the CLI's default preset (strict) included.
         self.assertEqual(self.result.config.to_dict(), flat_config(self.cli["config"]))
@@ -75,7 +76,7 @@ class MergeTest(unittest.TestCase):
         np.testing.assert_allclose(merged.origins[a.submap_count][:2], moved, atol=1e-9)
 
     def test_progress_counts_every_b_submap(self):
-        queried = self.result.queried
+        queried = self.result.submaps_queried
         self.assertEqual(self.calls, [(done, queried) for done in range(1, queried + 1)])
 
     def test_maps_as_objects_give_the_same_answer(self):

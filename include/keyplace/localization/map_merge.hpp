@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
+#include "keyplace/common/result_fields.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/place/place_config.hpp"
 
@@ -40,6 +41,11 @@ struct MergeResult {
   std::vector<SubmapRecognition> recognitions;  // the accepted ones (PlaceMatch::found)
   std::size_t agreeing = 0;
 };
+
+/// The figures of a merge and of each recognition (T_a_b aside, a pose): the keys of `keyplace
+/// merge --json` and the properties of Python's MergeResult / SubmapRecognition.
+const ResultFields<MergeResult>& MergeResultFields();
+const ResultFields<SubmapRecognition>& SubmapRecognitionFields();
 
 /// Progress: (B submaps recognised, B submaps to recognise: those with keypoints), after each.
 using MergeProgress = std::function<void(std::size_t, std::size_t)>;
