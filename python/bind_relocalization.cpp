@@ -79,22 +79,17 @@ PyRelocalization Relocalize(const std::string& log_path, const py::object& map,
 }
 
 void BindRecords(py::module_& module) {
-  py::class_<FixEvent>(module, "FixEvent", "One fix the relocalizer reported, checked.")
-      .def_readonly("scan", &FixEvent::scan, "Query-log scan it was reported at.")
-      .def_readonly("checked_scan", &FixEvent::checked_scan,
-                    "The scan it was checked at (the nearest with a truth pose).")
-      .def_property_readonly(
-          "pose", [](const FixEvent& f) { return PoseArray(f.T_world_robot); },
-          "T_world_robot (map frame) at checked_scan.")
+  py::class_<FixEvent> fix(module, "FixEvent", "One fix the relocalizer reported, checked.");
+  DefResultFields(fix, FixEventFields());
+  fix.def_property_readonly(
+         "pose", [](const FixEvent& f) { return PoseArray(f.T_world_robot); },
+         "T_world_robot (map frame) at checked_scan.")
       .def_property_readonly(
           "truth", [](const FixEvent& f) { return PoseArray(f.truth); },
           "True T_world_robot at checked_scan.")
       .def_property_readonly(
           "pose_at_fix", [](const FixEvent& f) { return PoseArray(f.initial_pose.T_map_robot); },
           "T_world_robot as reported at `scan` (what a robot publishes).")
-      .def_readonly("confidence", &FixEvent::confidence)
-      .def_readonly("correct", &FixEvent::correct, "Within 0.5 m and 10 deg of the truth.")
-      .def_readonly("first", &FixEvent::first, "The start's first fix.")
       .def(
           "initial_pose",
           [](const FixEvent& f, const std::string& frame_id) {
@@ -105,26 +100,9 @@ void BindRecords(py::module_& module) {
           py::arg("frame_id") = "map",
           "The fix as the /initialpose message (InitialPose), as reported at `scan`.");
 
-  py::class_<StartRecord>(module, "StartRecord", "One start of the benchmark.")
-      .def_readonly("start_scan", &StartRecord::start_scan)
-      .def_readonly("end_scan", &StartRecord::end_scan, "One past the last scan fed.")
-      .def_readonly("revisit", &StartRecord::revisit,
-                    "Its path before the cap passes a map scan the localizer may match.")
-      .def_readonly("distance_to_revisit_m", &StartRecord::distance_to_revisit_m)
-      .def_readonly("fixed", &StartRecord::fixed)
-      .def_readonly("scans_to_fix", &StartRecord::scans_to_fix)
-      .def_readonly("distance_to_fix_m", &StartRecord::distance_to_fix_m)
-      .def_readonly("first_fix_checked", &StartRecord::first_fix_checked)
-      .def_readonly("first_fix_correct", &StartRecord::first_fix_correct)
-      .def_readonly("answers", &StartRecord::answers)
-      .def_readonly("answers_accepted", &StartRecord::answers_accepted)
-      .def_readonly("fixes", &StartRecord::fixes, "The fixes reported (list of FixEvent).")
-      .def_readonly("wrong_fixes", &StartRecord::wrong_fixes)
-      .def_readonly("lost", &StartRecord::lost, "'lost' signals.")
-      .def_readonly("lost_on_correct_track", &StartRecord::lost_on_correct_track)
-      .def_readonly("lost_on_wrong_track", &StartRecord::lost_on_wrong_track)
-      .def_readonly("update_seconds_mean", &StartRecord::update_seconds_mean)
-      .def_readonly("update_seconds_max", &StartRecord::update_seconds_max);
+  py::class_<StartRecord> record(module, "StartRecord", "One start of the benchmark.");
+  DefResultFields(record, StartRecordFields());
+  record.def_readonly("fixes", &StartRecord::fixes, "The fixes reported (list of FixEvent).");
 }
 
 void BindRelocalizationEvaluation(py::module_& module) {

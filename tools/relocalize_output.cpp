@@ -10,6 +10,7 @@
 #include "io/atomic_file.hpp"
 #include "relocalization_figure.hpp"
 #include "result_json.hpp"
+#include "result_tsv.hpp"
 
 namespace keyplace::cli {
 
@@ -58,40 +59,24 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
 
 void WriteStartsTsv(const std::string& path, const std::vector<StartRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_"
-           "fix_m\t"
-           "first_fix_correct\tanswers\tanswers_accepted\tfixes\twrong_fixes\tlost\t"
-           "lost_on_correct_track\tlost_on_wrong_track\tupdate_seconds_mean\t"
-           "update_seconds_max\n";
-    for (const StartRecord& r : records) {
-      fmt::print(out,
-                 "{}\t{}\t{:d}\t{:.3f}\t{:d}\t{}\t{:.3f}\t{:d}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.6f}"
-                 "\t{:.6f}\n",
-                 r.start_scan, r.end_scan, r.revisit, r.distance_to_revisit_m, r.fixed,
-                 r.scans_to_fix, r.distance_to_fix_m, r.first_fix_correct, r.answers,
-                 r.answers_accepted, r.fixes.size(), r.wrong_fixes, r.lost, r.lost_on_correct_track,
-                 r.lost_on_wrong_track, r.update_seconds_mean, r.update_seconds_max);
-    }
+    out << ResultTsvHeader(StartRecordFields()) << '\n';
+    for (const StartRecord& r : records) out << ResultTsvRow(r, StartRecordFields()) << '\n';
   });
 }
 
+// A fix's figures (FixEventFields), then its estimate, the truth and the covariance at `scan`.
 void WriteFixesTsv(const std::string& path, const std::vector<StartRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "start_scan\tscan\tchecked_scan\tfirst\tcorrect\tconfidence\test_x\test_y\t"
-           "est_theta\ttrue_x\ttrue_y\ttrue_theta\terror_m\terror_deg\tcov_xx\tcov_xy\tcov_yy\t"
+    out << "start_scan\t" << ResultTsvHeader(FixEventFields())
+        << "\test_x\test_y\test_theta\ttrue_x\ttrue_y\ttrue_theta\tcov_xx\tcov_xy\tcov_yy\t"
            "cov_xtheta\tcov_ytheta\tcov_thetatheta\n";
     for (const StartRecord& r : records) {
       for (const FixEvent& f : r.fixes) {
-        const Pose2 error = Between(f.truth, f.T_world_robot);
-        const Eigen::Matrix3d& c = f.initial_pose.covariance;  // at `scan`
-        fmt::print(out,
-                   "{}\t{}\t{}\t{:d}\t{:d}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}\t{:.3f}\t{:.3f}\t{:.4f}"
-                   "\t{:.3f}\t{:.2f}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\t{:.4e}\n",
-                   r.start_scan, f.scan, f.checked_scan, f.first, f.correct, f.confidence,
-                   f.T_world_robot.x, f.T_world_robot.y, f.T_world_robot.theta, f.truth.x,
-                   f.truth.y, f.truth.theta, TranslationNorm(error),
-                   std::abs(error.theta) * 180.0 / M_PI, c(0, 0), c(0, 1), c(1, 1), c(0, 2),
-                   c(1, 2), c(2, 2));
+        const Eigen::Matrix3d& c = f.initial_pose.covariance;
+        fmt::print(out, "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\n", r.start_scan,
+                   ResultTsvRow(f, FixEventFields()), f.T_world_robot.x, f.T_world_robot.y,
+                   f.T_world_robot.theta, f.truth.x, f.truth.y, f.truth.theta, c(0, 0), c(0, 1),
+                   c(1, 1), c(0, 2), c(1, 2), c(2, 2));
       }
     }
   });

@@ -1,4 +1,8 @@
-// The figures of RelocalizationSummary (docs in keyplace/eval/relocalization.hpp).
+// The figures of RelocalizationSummary, StartRecord and FixEvent (docs in
+// keyplace/eval/relocalization.hpp).
+
+#include <cmath>
+#include <cstdint>
 
 #include "keyplace/eval/relocalization.hpp"
 
@@ -38,6 +42,63 @@ const ResultFields<RelocalizationSummary>& RelocalizationSummaryFields() {
         .Count("lost_signals", &S::lost_signals, "fixes given up (lost)")
         .Count("lost_on_correct_track", &S::lost_on_correct_track, "... while the fix was right")
         .Count("lost_on_wrong_track", &S::lost_on_wrong_track, "... while the fix was wrong");
+    return table;
+  }();
+  return fields;
+}
+
+const ResultFields<StartRecord>& StartRecordFields() {
+  using R = StartRecord;
+  static const ResultFields<R> fields = [] {
+    ResultFields<R> table;
+    table.Integer("start_scan", &R::start_scan, "query-log scan the start began at")
+        .Integer("end_scan", &R::end_scan, "one past the last scan fed")
+        .Switch("revisit", &R::revisit,
+                "its path before the cap passes a map scan the localizer may match")
+        .Number("distance_to_revisit_m", &R::distance_to_revisit_m, "m",
+                "odometry distance to the first such scan")
+        .Switch("fixed", &R::fixed, "the relocalizer reported a fix")
+        .Integer("scans_to_fix", &R::scans_to_fix, "scans fed up to and including the first fix")
+        .Number("distance_to_fix_m", &R::distance_to_fix_m, "m",
+                "odometry distance from the start to the first fix")
+        .Switch("first_fix_checked", &R::first_fix_checked,
+                "a truth pose was near enough to check the first fix")
+        .Switch("first_fix_correct", &R::first_fix_correct,
+                "the first fix was within 0.5 m and 10 deg of the truth")
+        .Integer("answers", &R::answers, "queries answered")
+        .Integer("answers_accepted", &R::answers_accepted,
+                 "... of them accepted by the place recognizer")
+        .Add("fixes_reported", "", "fixes reported (the list is `fixes`)",
+             [](const R& r) -> ResultValue { return static_cast<std::int64_t>(r.fixes.size()); })
+        .Integer("wrong_fixes", &R::wrong_fixes, "fixes more than 0.5 m or 10 deg off the truth")
+        .Integer("lost", &R::lost, "'lost' signals")
+        .Integer("lost_on_correct_track", &R::lost_on_correct_track, "... while the fix was right")
+        .Integer("lost_on_wrong_track", &R::lost_on_wrong_track, "... while the fix was wrong")
+        .Number("update_seconds_mean", &R::update_seconds_mean, "s",
+                "time of one update (AddScan with keypoints given), mean")
+        .Number("update_seconds_max", &R::update_seconds_max, "s", "... maximum");
+    return table;
+  }();
+  return fields;
+}
+
+const ResultFields<FixEvent>& FixEventFields() {
+  using R = FixEvent;
+  static const ResultFields<R> fields = [] {
+    ResultFields<R> table;
+    table.Integer("scan", &R::scan, "query-log scan the fix was reported at")
+        .Integer("checked_scan", &R::checked_scan,
+                 "the scan it was checked at (the nearest with a truth pose)")
+        .Switch("first", &R::first, "the start's first fix")
+        .Switch("correct", &R::correct, "within 0.5 m and 10 deg of the truth")
+        .Number("confidence", &R::confidence, "", "in [0, 1]")
+        .Add("error_m", "m", "distance from the truth at checked_scan",
+             [](const R& f) -> ResultValue {
+               return TranslationNorm(Between(f.truth, f.T_world_robot));
+             })
+        .Add("error_deg", "deg", "heading error at checked_scan", [](const R& f) -> ResultValue {
+          return std::abs(Between(f.truth, f.T_world_robot).theta) * 180.0 / M_PI;
+        });
     return table;
   }();
   return fields;

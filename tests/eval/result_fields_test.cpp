@@ -130,5 +130,51 @@ TEST(ResultFields, SlamEvaluationFiguresAreMissingWithoutLoopsOrTruth) {
   EXPECT_EQ(ValueOf(fields, e, "loops_truth_evaluated"), ResultValue(std::int64_t{0}));
 }
 
+TEST(ResultFields, StartRecordAndFixEventFiguresReadTheirOwnMembers) {
+  StartRecord r;
+  r.start_scan = 1;
+  r.end_scan = 2;
+  r.revisit = true;
+  r.distance_to_revisit_m = 0.5;
+  r.scans_to_fix = 3;
+  r.distance_to_fix_m = 1.5;
+  r.answers = 4;
+  r.answers_accepted = 5;
+  r.fixes.resize(6);
+  r.wrong_fixes = 7;
+  r.lost = 8;
+  r.lost_on_correct_track = 9;
+  r.lost_on_wrong_track = 10;
+  r.update_seconds_mean = 2.5;
+  r.update_seconds_max = 3.5;
+  // The three other switches stay false: ExpectWellFormed needs one value per figure, so they are
+  // checked one by one.
+  const ResultFields<StartRecord>& fields = StartRecordFields();
+  EXPECT_EQ(fields.fields().size(), 18u);
+  EXPECT_EQ(ValueOf(fields, r, "fixes_reported"), ResultValue(std::int64_t{6}));
+  for (bool StartRecord::*member :
+       {&StartRecord::fixed, &StartRecord::first_fix_checked, &StartRecord::first_fix_correct}) {
+    StartRecord one = r;
+    one.revisit = false;
+    one.*member = true;
+    int true_figures = 0;
+    for (const ResultField<StartRecord>& field : fields.fields()) {
+      true_figures += field.value(one) == ResultValue(true);
+    }
+    EXPECT_EQ(true_figures, 1);
+  }
+
+  FixEvent f;
+  f.scan = 11;
+  f.checked_scan = 12;
+  f.first = true;
+  f.confidence = 0.75;
+  f.T_world_robot = Pose2{3.0, 4.0, 0.1};
+  f.truth = Pose2{0.0, 0.0, 0.0};
+  ExpectWellFormed(FixEventFields(), f);
+  EXPECT_EQ(ValueOf(FixEventFields(), f, "error_m"), ResultValue(5.0));
+  EXPECT_NEAR(std::get<double>(ValueOf(FixEventFields(), f, "error_deg")), 5.729578, 1e-6);
+}
+
 }  // namespace
 }  // namespace keyplace

@@ -44,7 +44,7 @@ class RelocalizationTest(unittest.TestCase):
         fixes = os.path.join(self.work.name, name + "-fixes.tsv")
         run_cli("relocalize", "--map", self.map_path, "--log", self.log_path, "--starts",
                 str(STARTS), "--json", figures, "--initialpose", fix, "--fixes", fixes,
-                *arguments)
+                "--tsv", os.path.join(self.work.name, name + "-starts.tsv"), *arguments)
         with open(figures) as stream:
             cli = json.load(stream)
         text = None
@@ -77,8 +77,19 @@ class RelocalizationTest(unittest.TestCase):
         rows = np.genfromtxt(fixes_path, delimiter="\t", names=True, ndmin=1)
         fixes = [f for record in evaluation.records for f in record.fixes]
         self.assertEqual(len(fixes), len(rows))
-        np.testing.assert_allclose([f.pose[0] for f in fixes], rows["est_x"], atol=6e-4)
-        self.assertEqual([f.correct for f in fixes], list(rows["correct"].astype(bool)))
+        # Each column named as the property and written from the same table, exactly.
+        for name in rows.dtype.names:
+            if hasattr(fixes[0], name):
+                self.assertEqual([float(getattr(f, name)) for f in fixes], list(rows[name]), name)
+        self.assertEqual([f.pose[0] for f in fixes], list(rows["est_x"]))
+        starts = np.genfromtxt(os.path.join(self.work.name, "none-starts.tsv"), delimiter="\t",
+                               names=True, ndmin=1)
+        self.assertEqual(len(starts), len(evaluation.records))
+        self.assertIn("fixes_reported", starts.dtype.names)
+        for name in starts.dtype.names:
+            if "seconds" not in name:
+                self.assertEqual([float(getattr(r, name)) for r in evaluation.records],
+                                 list(starts[name]), name)
         # The first fix as the /initialpose message, the text --initialpose wrote.
         start_scan, first = evaluation.first_fix()
         self.assertTrue(first.first)

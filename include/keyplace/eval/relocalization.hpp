@@ -113,6 +113,11 @@ struct RelocalizationSummary {
 /// of Python's RelocalizationEvaluation.
 const ResultFields<RelocalizationSummary>& RelocalizationSummaryFields();
 
+/// The figures of one start and of one fix (the poses and covariance aside): the columns of
+/// `keyplace relocalize --tsv` / `--fixes` and the properties of Python's StartRecord / FixEvent.
+const ResultFields<StartRecord>& StartRecordFields();
+const ResultFields<FixEvent>& FixEventFields();
+
 /// Progress: (starts done, starts in all), called from one thread at a time, counting up.
 using StartProgress = std::function<void(std::size_t, std::size_t)>;
 
