@@ -39,7 +39,7 @@ empty :=
 space := $(empty) $(empty)
 SANITIZE_SKIP := ^($(subst $(space),|,$(strip $(SANITIZE_SKIP_TESTS))))$$
 
-.PHONY: all deps configure build build-demo demo test test-fast test-slow build-sanitize \
+.PHONY: all deps deps-demo configure configure-demo build build-demo demo test test-fast test-slow build-sanitize \
   test-sanitize fuzz bench report format format-check tidy-configure tidy tidy-ci install \
   clean
 
@@ -48,15 +48,30 @@ all: build
 deps:
 	@bash scripts/install-deps.sh
 
+# Only the packages the demo builds with: a fresh machine's `make demo` does not wait for the test
+# tools (GoogleTest, clang, Chromium, roscore, ...).
+deps-demo:
+	@bash scripts/install-deps.sh --demo
+
+CONFIGURE := cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+
+# Tests and benchmarks are part of the build: a missing package fails here, not by skipping them.
 configure: deps
-	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) >/dev/null
+	@$(CONFIGURE) -DKEYPLACE_BUILD_TESTS=ON -DKEYPLACE_BUILD_BENCHMARKS=ON >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
+# The demo's configuration keeps the tests and benchmarks where their packages are there (after a
+# `make test`) and leaves them out on a machine that has only the demo's; the Python module and
+# the ROS nodes are left out by CMake itself when their packages are missing.
+TEST_PACKAGES_THERE = $(shell bash scripts/install-deps.sh --check >/dev/null 2>&1 && echo ON || echo OFF)
+configure-demo: deps-demo
+	@$(CONFIGURE) -DKEYPLACE_BUILD_TESTS=$(TEST_PACKAGES_THERE) -DKEYPLACE_BUILD_BENCHMARKS=$(TEST_PACKAGES_THERE) >/dev/null
+
 # What the demo runs and nothing else: the library, the keyplace command and the streaming example
 # (no tests, fuzz replays, benchmarks or Python module; `make test` builds those).
-build-demo: configure
+build-demo: configure-demo
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target keyplace_cli localize_stream
 
 # The main job on the bundled data set, printing its results.
