@@ -2,7 +2,6 @@
 // keyplace/eval/relocalization.hpp).
 
 #include <cmath>
-#include <cstdint>
 
 #include "keyplace/eval/relocalization.hpp"
 
@@ -69,7 +68,7 @@ const ResultFields<StartRecord>& StartRecordFields() {
         .Integer("answers_accepted", &R::answers_accepted,
                  "... of them accepted by the place recognizer")
         .Add("fixes_reported", "", "fixes reported (the list is `fixes`)",
-             [](const R& r) -> ResultValue { return static_cast<std::int64_t>(r.fixes.size()); })
+             [](const R& r) -> ResultValue { return CountValue(r.fixes.size()); })
         .Integer("wrong_fixes", &R::wrong_fixes, "fixes more than 0.5 m or 10 deg off the truth")
         .Integer("lost", &R::lost, "'lost' signals")
         .Integer("lost_on_correct_track", &R::lost_on_correct_track, "... while the fix was right")

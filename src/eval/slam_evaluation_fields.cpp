@@ -7,13 +7,11 @@
 namespace keyplace {
 namespace {
 
-ResultValue Count(std::size_t count) { return static_cast<std::int64_t>(count); }
-
 // A run's counters live in its OnlineSlam (SlamStats).
 ResultFields<SlamRun>& AddStatsCount(ResultFields<SlamRun>& table, const char* name,
                                      std::size_t SlamStats::*member, const char* meaning) {
   return table.Add(name, "", meaning, [member](const SlamRun& run) -> ResultValue {
-    return Count(run.slam->stats().*member);
+    return CountValue(run.slam->stats().*member);
   });
 }
 
@@ -58,7 +56,7 @@ ResultFields<SlamRun> MakeSlamRunFields() {
   table.Count("scans", &SlamRun::scans, "scans of the log given to SLAM");
   AddStatsCount(table, "queries", &SlamStats::queries, "completed submaps matched against the map");
   table.Add("loops_detected", "", "loops place recognition found (accepted or not)",
-            [](const SlamRun& run) -> ResultValue { return Count(run.slam->loops().size()); });
+            [](const SlamRun& run) -> ResultValue { return CountValue(run.slam->loops().size()); });
   AddStatsCount(table, "loops_accepted", &SlamStats::loops_accepted, "loops that passed the gate");
   AddStatsCount(table, "loops_refined", &SlamStats::loops_refined,
                 "loop transforms refined by ICP");
@@ -86,7 +84,7 @@ ResultFields<SlamRun> MakeSlamRunFields() {
 
 void AddLoopFigures(ResultFields<SlamEvaluation>& table) {
   table.Add("loops_used", "", "loops used in the final graph",
-            [](const SlamEvaluation& e) -> ResultValue { return Count(e.loops.used_count); });
+            [](const SlamEvaluation& e) -> ResultValue { return CountValue(e.loops.used_count); });
   AddPrecision(table, "precision_overlap_10", &LoopPrecisions::overlap_10,
                "share of loops whose submaps overlap by 10 % (Figure 10)");
   AddPrecision(table, "precision_overlap_30", &LoopPrecisions::overlap_30, "... by 30 %");
@@ -126,7 +124,7 @@ void AddTruthFigures(ResultFields<SlamEvaluation>& table) {
   table.Add("truth_pairs", "", "scans with a truth pose, paired for ATE and RPE",
             [](const SlamEvaluation& e) -> ResultValue {
               if (!e.accuracy) return {};
-              return Count(e.accuracy->truth_pairs);
+              return CountValue(e.accuracy->truth_pairs);
             });
   AddAccuracy(table, "ate_rmse_m", "m", "ATE of SLAM after SE(2) alignment, RMSE",
               [](const SlamAccuracy& a) { return a.ate.translation_rmse_m; });

@@ -1,7 +1,5 @@
 // The figures of MergeResult and SubmapRecognition (docs in keyplace/localization/map_merge.hpp).
 
-#include <cstdint>
-
 #include "keyplace/localization/map_merge.hpp"
 
 namespace keyplace {
@@ -12,14 +10,10 @@ const ResultFields<MergeResult>& MergeResultFields() {
     ResultFields<R> table;
     table.Count("submaps_queried", &R::queried, "B submaps with keypoints, each recognised in A")
         .Add("recognised", "", "B submaps recognised in A (accepted answers)",
-             [](const R& r) -> ResultValue {
-               return static_cast<std::int64_t>(r.recognitions.size());
-             })
+             [](const R& r) -> ResultValue { return CountValue(r.recognitions.size()); })
         .Count("agreeing", &R::agreeing, "recognitions in the largest group agreeing on T_a_b")
         .Add("submaps_merged", "", "submaps of the merged map (A's, then B's)",
-             [](const R& r) -> ResultValue {
-               return static_cast<std::int64_t>(r.merged.submaps.size());
-             });
+             [](const R& r) -> ResultValue { return CountValue(r.merged.submaps.size()); });
     return table;
   }();
   return fields;

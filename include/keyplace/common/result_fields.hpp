@@ -20,6 +20,9 @@ namespace keyplace {
 /// Python None. A share of nothing is missing, not 0.
 using ResultValue = std::variant<std::monostate, bool, std::int64_t, double, std::string>;
 
+/// A count (a std::size_t: a member, a container's size) as a figure's value.
+inline ResultValue CountValue(std::size_t count) { return static_cast<std::int64_t>(count); }
+
 template <typename Result>
 struct ResultField {
   std::string name;     // snake_case with the unit in it where it has one: "distance_m"
@@ -32,9 +35,8 @@ template <typename Result>
 class ResultFields {
  public:
   ResultFields& Count(const char* name, std::size_t Result::*member, const char* meaning) {
-    return Add(name, "", meaning, [member](const Result& result) -> ResultValue {
-      return static_cast<std::int64_t>(result.*member);
-    });
+    return Add(name, "", meaning,
+               [member](const Result& result) { return CountValue(result.*member); });
   }
   ResultFields& Integer(const char* name, int Result::*member, const char* meaning) {
     return Add(name, "", meaning, [member](const Result& result) -> ResultValue {
