@@ -8,8 +8,8 @@
 
 # Which modules each module may include (besides itself): their public headers
 # (include/keyplace/<module>/) and internal ones (src/<module>/). config composes every module's
-# configuration; store (the configuration recorded in a map) and localization (the node core takes
-# a whole Config) use it back, "config:public": its public headers only, and through them only
+# configuration; store (the configuration recorded in a map), slam and localization (their node
+# cores take a whole Config) use it back, "config:public": its public headers only, and through them only
 # the headers those need.
 set(KEYPLACE_MODULE_USES_common "")
 set(KEYPLACE_MODULE_USES_io common)
@@ -18,7 +18,7 @@ set(KEYPLACE_MODULE_USES_registration common io)
 set(KEYPLACE_MODULE_USES_mapping common io features registration)
 set(KEYPLACE_MODULE_USES_place common io features mapping)
 set(KEYPLACE_MODULE_USES_store common io mapping config:public)
-set(KEYPLACE_MODULE_USES_slam common io features registration mapping place)
+set(KEYPLACE_MODULE_USES_slam common io features registration mapping place store config:public)
 set(KEYPLACE_MODULE_USES_localization common io features mapping place store config:public)
 set(KEYPLACE_MODULE_USES_eval common io features registration mapping place localization slam)
 set(KEYPLACE_MODULE_USES_config common io features registration mapping place slam localization

@@ -4,7 +4,6 @@
 // file only converts messages (docs/ROS.md, "On a robot").
 
 #include <algorithm>
-#include <cstdio>
 #include <exception>
 #include <memory>
 #include <stdexcept>
@@ -12,7 +11,6 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
-#include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -22,16 +20,11 @@
 
 #include "keyplace/localization/relocalization_node.hpp"
 #include "keyplace/store/map_file.hpp"
+#include "node_messages.hpp"
 #include "ros_support.hpp"
 
 namespace keyplace::ros1 {
 namespace {
-
-std::string Text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.6g", value);
-  return text;
-}
 
 class RelocalizeNode {
  public:
@@ -85,32 +78,12 @@ class RelocalizeNode {
   void OnScan(const sensor_msgs::LaserScan::ConstPtr& message) {
     try {
       const Config& config = core_.config();
-      ScanInput scan;
-      scan.stamp_s = message->header.stamp.toSec();
-      scan.frame_id = message->header.frame_id;
-      scan.angle_min_rad = message->angle_min;
-      scan.angle_increment_rad = message->angle_increment;
-      scan.range_min_m = message->range_min;
-      scan.range_max_m = message->range_max;
-      scan.ranges_m = message->ranges;
-      if (config.input.laser_pose.empty()) {
-        std::string error;
-        scan.T_robot_laser = LookupPose(tf_buffer_, config.input.base_frame, scan.frame_id,
-                                        message->header.stamp, ros::Duration(0.0), &error);
-        if (!scan.T_robot_laser) ROS_WARN_THROTTLE(5.0, "keyplace: laser pose: %s", error.c_str());
-      }
       if (config.node.odometry == NodeOdometry::kTf) {
-        std::string error;
-        const std::optional<Pose2> T_odom_robot =
-            LookupPose(tf_buffer_, config.input.odom_frame, config.input.base_frame,
-                       message->header.stamp, ros::Duration(config.node.odometry_wait_s), &error);
-        if (T_odom_robot) {
-          Publish(core_.AddOdometry({scan.stamp_s, *T_odom_robot}));
-        } else {
-          ROS_WARN_THROTTLE(5.0, "keyplace: odometry from tf: %s", error.c_str());
-        }
+        const std::optional<OdometryInput> odometry =
+            TfOdometryAt(message->header.stamp, config, tf_buffer_);
+        if (odometry) Publish(core_.AddOdometry(*odometry));
       }
-      Publish(core_.AddScan(scan));
+      Publish(core_.AddScan(ScanInputOf(*message, config, tf_buffer_)));
     } catch (const std::exception& error) {
       ROS_ERROR("keyplace: scan: %s", error.what());
     }
@@ -118,9 +91,7 @@ class RelocalizeNode {
 
   void OnOdometry(const nav_msgs::Odometry::ConstPtr& message) {
     try {
-      const geometry_msgs::Point& p = message->pose.pose.position;
-      Publish(core_.AddOdometry(
-          {message->header.stamp.toSec(), Pose2(p.x, p.y, YawOf(message->pose.pose.orientation))}));
+      Publish(core_.AddOdometry(OdometryInputOf(*message)));
     } catch (const std::exception& error) {
       ROS_ERROR("keyplace: odometry: %s", error.what());
     }
@@ -156,21 +127,11 @@ class RelocalizeNode {
   }
 
   void Publish(const NodeOutput& output) {
-    for (const NodeEvent& event : output.events) {
-      switch (event.level) {
-        case NodeEventLevel::kInfo:
-          ROS_INFO("keyplace: %s", event.what.c_str());
-          break;
-        case NodeEventLevel::kWarning:
-          ROS_WARN("keyplace: %s", event.what.c_str());
-          break;
-        case NodeEventLevel::kError:
-          ROS_ERROR("keyplace: %s", event.what.c_str());
-          break;
-      }
-    }
+    LogEvents(output.events);
     for (const StampedInitialPose& fix : output.initial_poses) PublishInitialPose(fix);
-    for (const StampedTransform& transform : output.transforms) PublishTransform(transform);
+    for (const StampedTransform& transform : output.transforms) {
+      tf_broadcaster_.sendTransform(TransformMessageOf(transform));
+    }
     if (output.status_due) PublishStatus();
   }
 
@@ -186,17 +147,6 @@ class RelocalizeNode {
     initial_pose_publisher_.publish(message);
   }
 
-  void PublishTransform(const StampedTransform& transform) {
-    geometry_msgs::TransformStamped message;
-    message.header.stamp.fromSec(transform.stamp_s);
-    message.header.frame_id = transform.parent_frame;
-    message.child_frame_id = transform.child_frame;
-    message.transform.translation.x = transform.T_parent_child.x;
-    message.transform.translation.y = transform.T_parent_child.y;
-    message.transform.rotation = QuaternionOf(transform.T_parent_child.theta);
-    tf_broadcaster_.sendTransform(message);
-  }
-
   void PublishStatus() {
     const NodeStatus status = core_.status();
     diagnostic_msgs::DiagnosticStatus diagnostic;
@@ -206,23 +156,20 @@ class RelocalizeNode {
                                                           : diagnostic_msgs::DiagnosticStatus::WARN;
     diagnostic.message = ToString(status.status);
     const auto value = [&](const std::string& key, const std::string& text) {
-      diagnostic_msgs::KeyValue entry;
-      entry.key = key;
-      entry.value = text;
-      diagnostic.values.push_back(entry);
+      AddDiagnosticValue(key, text, diagnostic);
     };
     value("status", ToString(status.status));
-    value("confidence", Text(status.confidence));
+    value("confidence", DiagnosticNumber(status.confidence));
     if (status.pose) {
-      value("x", Text(status.pose->T_map_robot.x));
-      value("y", Text(status.pose->T_map_robot.y));
-      value("theta", Text(status.pose->T_map_robot.theta));
+      value("x", DiagnosticNumber(status.pose->T_map_robot.x));
+      value("y", DiagnosticNumber(status.pose->T_map_robot.y));
+      value("theta", DiagnosticNumber(status.pose->T_map_robot.theta));
     }
     if (status.last_answer) {
       const NodeAnswer& answer = *status.last_answer;
-      value("last_answer_stamp", Text(answer.stamp_s));
+      value("last_answer_stamp", DiagnosticNumber(answer.stamp_s));
       value("last_answer", answer.found ? "found" : answer.ambiguous ? "ambiguous" : "not found");
-      value("last_answer_confidence", Text(answer.confidence));
+      value("last_answer_confidence", DiagnosticNumber(answer.confidence));
     }
     value("scans_received", std::to_string(status.scans_received));
     value("scans_processed", std::to_string(status.scans_processed));
@@ -232,10 +179,10 @@ class RelocalizeNode {
     value("answers", std::to_string(status.answers));
     value("fixes", std::to_string(status.fixes));
     value("losses", std::to_string(status.losses));
-    value("last_scan_stamp", Text(status.last_scan_stamp_s));
-    value("latency_mean_s", Text(status.latency_mean_s));
-    value("latency_p99_s", Text(status.latency_p99_s));
-    value("latency_max_s", Text(status.latency_max_s));
+    value("last_scan_stamp", DiagnosticNumber(status.last_scan_stamp_s));
+    value("latency_mean_s", DiagnosticNumber(status.latency_mean_s));
+    value("latency_p99_s", DiagnosticNumber(status.latency_p99_s));
+    value("latency_max_s", DiagnosticNumber(status.latency_max_s));
     diagnostic_msgs::DiagnosticArray array;
     array.header.stamp = ros::Time::now();
     array.status.push_back(diagnostic);

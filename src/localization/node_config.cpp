@@ -36,6 +36,10 @@ void Validate(const NodeConfig& config) {
     fail("status_period_s must be in (0, 3600] s");
   }
   if (config.status_path.empty()) fail("status_path must not be empty");
+  if (!(config.map_period_s > 0.0 && config.map_period_s <= 3600.0)) {
+    fail("map_period_s must be in (0, 3600] s");
+  }
+  if (config.map_path.empty()) fail("map_path must not be empty");
 }
 
 const ConfigFields<NodeConfig>& NodeConfigFields() {
@@ -56,7 +60,11 @@ const ConfigFields<NodeConfig>& NodeConfigFields() {
                 "a scan waits for odometry at its stamp until a scan this much newer comes")
         .Double("status_period_s", &C::status_period_s, "s",
                 "the status (and map -> odom when fixed) goes out at least this often")
-        .Text("status_path", &C::status_path, "", "file ~save_status writes (YAML)");
+        .Text("status_path", &C::status_path, "", "file ~save_status writes (YAML)")
+        .Double("map_period_s", &C::map_period_s, "s",
+                "SLAM node: /map goes out at most this often while scans come")
+        .Text("map_path", &C::map_path, "",
+              "SLAM node: map ~save_map writes (.kpm; the map_server grid beside it, .yaml/.pgm)");
     return table;
   }();
   return fields;

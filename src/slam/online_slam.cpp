@@ -335,19 +335,25 @@ bool OnlineSlam::LoopUsed(const LoopClosure& loop) const {
 std::vector<OnlineSlam::ScanPose> OnlineSlam::Trajectory() const {
   std::vector<ScanPose> trajectory;
   trajectory.reserve(scans_.size());
-  const int last = static_cast<int>(map_.submaps.size()) - 1;
-  for (const ScanRecord& record : scans_) {
-    ScanPose pose;
-    pose.scan_index = record.scan_index;
-    pose.timestamp_s = record.timestamp_s;
-    pose.T_world_robot_icp = record.icp;
-    pose.submap = record.submap;
-    const int anchor = record.submap >= 0 ? record.submap : last;
-    pose.T_world_robot =
-        anchor >= 0 ? graph_.node(anchor) * Between(icp_origins_[anchor], record.icp) : record.icp;
-    trajectory.push_back(pose);
-  }
+  for (const ScanRecord& record : scans_) trajectory.push_back(PoseOf(record));
   return trajectory;
+}
+
+OnlineSlam::ScanPose OnlineSlam::LatestPose() const {
+  return scans_.empty() ? ScanPose{} : PoseOf(scans_.back());
+}
+
+OnlineSlam::ScanPose OnlineSlam::PoseOf(const ScanRecord& record) const {
+  ScanPose pose;
+  pose.scan_index = record.scan_index;
+  pose.timestamp_s = record.timestamp_s;
+  pose.T_world_robot_icp = record.icp;
+  pose.submap = record.submap;
+  const int last = static_cast<int>(map_.submaps.size()) - 1;
+  const int anchor = record.submap >= 0 ? record.submap : last;
+  pose.T_world_robot =
+      anchor >= 0 ? graph_.node(anchor) * Between(icp_origins_[anchor], record.icp) : record.icp;
+  return pose;
 }
 
 }  // namespace keyplace

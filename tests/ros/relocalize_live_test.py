@@ -14,15 +14,16 @@ Usage: relocalize_live_test.py KEYPLACE_CLI NODE_BINARY SOURCE_DIR [--rate R] [-
 """
 
 import argparse
-import gzip
 import math
 import os
-import signal
-import socket
 import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from live_support import (Processes, corrected_poses, ros_environment, start_roscore,  # noqa: E402
+                          wait_for)
 
 MAP_SCANS = "0:732"     # corrected scans of the map: raw scans 0..2465, bag time up to 1743.1 s
 PLAY_START_S = 532.0    # bag offset of raw scan 2466 (1743.6 s; the bag starts at 1211.52 s)
@@ -31,74 +32,6 @@ TOLERANCE_DEG = 10.0
 # The bag's converter wrote the laser at x = +0.04 m and beams pi/359 apart; the log has -0.04 m
 # and pi/360 (docs/ROS.md, "Checked against a real bag").
 BAG_FIXES = "input.laser_pose=-0.04,0,0 input.scan_fov_rad=3.141592653589793"
-
-
-def free_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def corrected_poses(path):
-    """(stamp, x, y, theta) of every ROBOTLASER1 line: its ipc_timestamp and its robot pose."""
-    poses = []
-    with gzip.open(path, "rt") as log:
-        for line in log:
-            fields = line.split()
-            if not fields or fields[0] != "ROBOTLASER1":
-                continue
-            beams = int(fields[8])
-            rest = fields[9 + beams:]
-            remissions = int(rest[0])
-            rest = rest[1 + remissions:]
-            # laser x y theta, robot x y theta, tv rv forward side turn, ipc_timestamp ...
-            robot = [float(v) for v in rest[3:6]]
-            poses.append((float(rest[11]), robot[0], robot[1], robot[2]))
-    return poses
-
-
-class Processes:
-    """Processes started by the test, each in its own session, killed by id at the end."""
-
-    def __init__(self, env, log_dir):
-        self.env = env
-        self.log_dir = log_dir
-        self.started = []
-
-    def start(self, name, command):
-        log = open(os.path.join(self.log_dir, name + ".log"), "w")
-        process = subprocess.Popen(command, env=self.env, stdout=log, stderr=subprocess.STDOUT,
-                                   start_new_session=True)
-        self.started.append((name, process, log))
-        return process
-
-    def stop(self, process, timeout_s=10.0):
-        if process.poll() is not None:
-            return
-        os.killpg(process.pid, signal.SIGINT)
-        try:
-            process.wait(timeout_s)
-        except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGKILL)
-            process.wait(timeout_s)
-
-    def stop_all(self):
-        for _, process, log in reversed(self.started):
-            self.stop(process)
-            log.close()
-
-    def log_of(self, name):
-        with open(os.path.join(self.log_dir, name + ".log")) as log:
-            return log.read()
-
-
-def wait_for(condition, timeout_s, what):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.05)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout_s, what))
 
 
 def main():
@@ -117,12 +50,7 @@ def main():
             raise SystemExit("missing " + path)
 
     work = tempfile.mkdtemp(prefix="keyplace_ros_live_")
-    port = free_port()
-    env = dict(os.environ)
-    env.update({"ROS_MASTER_URI": "http://127.0.0.1:%d" % port, "ROS_IP": "127.0.0.1",
-                "ROS_HOSTNAME": "127.0.0.1", "ROS_HOME": work,
-                "ROS_LOG_DIR": os.path.join(work, "log")})
-    os.environ.update(env)  # for rospy in this process
+    env = ros_environment(work)
 
     map_path = os.path.join(work, "first_half.kpm")
     subprocess.run([args.keyplace, "map", os.path.join(args.source_dir, "data",
@@ -138,14 +66,7 @@ def main():
 
 
 def run(args, processes, env, work, map_path, bag, truth_log):
-    roscore = processes.start("roscore", ["roscore", "-p", env["ROS_MASTER_URI"].split(":")[-1]])
-    import rosgraph  # after the environment names the private master
-
-    master = rosgraph.Master("/keyplace_live_test")
-    wait_for(lambda: master.is_online() or roscore.poll() is not None, 30, "roscore")
-    assert roscore.poll() is None, processes.log_of("roscore")
-    master.setParam("/use_sim_time", True)
-
+    start_roscore(processes, env)
     import rospy
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseWithCovarianceStamped

@@ -1,6 +1,7 @@
 #pragma once
-// What a relocalization node publishes and how long it waits: config section `node`
-// (RelocalizationNode, the ROS node keyplace_ros_relocalize; docs/ROS.md, "On a robot").
+// What keyplace's robot nodes publish and how long they wait: config section `node`
+// (RelocalizationNode and SlamNode, the ROS nodes keyplace_ros_relocalize and keyplace_ros_slam;
+// docs/ROS.md, "On a robot").
 
 #include <string>
 
@@ -36,6 +37,13 @@ struct NodeConfig {
   double status_period_s = 1.0;
   // Where ~save_status writes the status (YAML); relative paths are the node's working directory.
   std::string status_path = "keyplace_status.yaml";
+  // SLAM node: the occupancy grid of the scans at their current poses goes out on /map at most
+  // this often (stamps' time), when scans came since the last one. It is rebuilt from all
+  // keyframes each time, as a loop closure moves them all.
+  double map_period_s = 5.0;
+  // SLAM node: where ~save_map writes the map (.kpm); the map_server grid goes beside it, the
+  // same path with .yaml and .pgm. Relative paths are the node's working directory.
+  std::string map_path = "keyplace_map.kpm";
 };
 
 /// Throws std::invalid_argument naming the first invalid field (NodeConfig.<field>).

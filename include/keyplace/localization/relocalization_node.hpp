@@ -21,52 +21,18 @@
 
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/config/config.hpp"
+#include "keyplace/io/sensor_input.hpp"
+#include "keyplace/io/sensor_sync.hpp"
 #include "keyplace/localization/initial_pose.hpp"
 #include "keyplace/localization/relocalizer.hpp"
 #include "keyplace/mapping/global_map.hpp"
 
 namespace keyplace {
 
-/// One laser scan as a driver sends it (sensor_msgs/LaserScan).
-struct ScanInput {
-  double stamp_s = 0.0;
-  std::string frame_id;
-  double angle_min_rad = 0.0;
-  double angle_increment_rad = 0.0;
-  double range_min_m = 0.0;
-  double range_max_m = 0.0;
-  std::vector<float> ranges_m;
-  // The laser on the robot (base_frame -> frame_id, from tf), when the wrapper has it;
-  // input.laser_pose overrides it.
-  std::optional<Pose2> T_robot_laser;
-};
-
-/// One odometry pose (nav_msgs/Odometry, or the tf chain odom_frame -> base_frame).
-struct OdometryInput {
-  double stamp_s = 0.0;
-  Pose2 T_odom_robot;
-};
-
-enum class NodeEventLevel { kInfo, kWarning, kError };
-
-/// Something the wrapper should log.
-struct NodeEvent {
-  NodeEventLevel level = NodeEventLevel::kInfo;
-  std::string what;
-};
-
 /// /initialpose: the fix with the stamp of the scan it was declared at.
 struct StampedInitialPose {
   double stamp_s = 0.0;
   InitialPose pose;
-};
-
-/// A transform to broadcast on tf.
-struct StampedTransform {
-  double stamp_s = 0.0;
-  std::string parent_frame;
-  std::string child_frame;
-  Pose2 T_parent_child;
 };
 
 /// The localizer's latest answer (a query submap completed).
@@ -127,8 +93,6 @@ class RelocalizationNode {
  public:
   /// Scans processed scans the latency figures of NodeStatus cover.
   static constexpr std::size_t kLatencyWindow = 10000;
-  /// Odometry samples kept at most: 100 s at 100 Hz while no scan comes.
-  static constexpr std::size_t kMaxOdometrySamples = 10000;
 
   /// The localizer of `config` (localization, place, features; its input section says where
   /// the laser sits and how beams are spread, its node section what is published). Throws
@@ -156,34 +120,23 @@ class RelocalizationNode {
   void SaveStatus(const std::string& path) const;
 
  private:
-  struct PendingScan {
-    LaserScan scan;
-    std::string frame_id;
-  };
-
-  // The scan as the localizer takes it, or nothing (with an event saying why).
-  std::optional<LaserScan> Convert(const ScanInput& input, NodeOutput& output);
-  void NoteGeometry(const ScanInput& input, const Pose2& T_robot_laser, NodeOutput& output);
-  // Processes the waiting scans that odometry covers now.
-  void Drain(NodeOutput& output);
-  // The odometry pose at `stamp_s`, when the samples cover it.
-  std::optional<Pose2> OdometryAt(double stamp_s) const;
+  void Release(SyncOutput synced, NodeOutput& output);
   void Process(const LaserScan& scan, const Pose2& T_odom_robot, NodeOutput& output);
   void Publish(const RelocalizationUpdate& update, double stamp_s, NodeOutput& output);
-  void RepublishIfDue(double now_s, NodeOutput& output);
-  void RecordLatency(double latency_s);
+  // The status every node.status_period_s; map -> odom when the wrapper's clock finds none sent
+  // for as long (scans send theirs; not at a message's stamp: tf refuses a second transform at a
+  // stamp it has, and a scan's odometry comes at the scan's stamp, just before it).
+  void RepublishIfDue(double now_s, bool clock, NodeOutput& output);
   void Drop(const std::string& why, NodeOutput& output);
 
   Config config_;
   Relocalizer relocalizer_;
-  std::optional<Pose2> laser_pose_override_;
+  SensorSync sync_;
   NodeStatus status_;
-  std::deque<OdometryInput> odometry_;       // in stamp order, trimmed to what waiting scans need
-  std::deque<PendingScan> pending_;          // scans waiting for odometry, in stamp order
-  std::optional<double> last_scan_stamp_s_;  // of the last scan accepted (waiting or processed)
-  std::optional<Pose2> last_T_odom_robot_;   // of the last processed scan
-  std::optional<ScanInput> geometry_;        // the last scan's geometry (its ranges left empty)
-  std::optional<double> last_status_s_;      // when the status was last due
+  std::size_t scans_failed_ = 0;            // released scans the localizer could not take
+  std::optional<Pose2> last_T_odom_robot_;  // of the last processed scan
+  std::optional<double> last_status_s_;     // when the status was last due
+  std::optional<double> last_transform_s_;  // stamp of the last map -> odom sent
   std::deque<double> latencies_s_;
 };
 

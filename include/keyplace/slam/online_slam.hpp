@@ -179,6 +179,9 @@ class OnlineSlam {
     int submap = -1;          // the submap the scan belongs to (-1: not completed yet)
   };
   std::vector<ScanPose> Trajectory() const;
+  /// The same for the last scan added (as Trajectory().back(), in constant time); the first
+  /// scan's pose before any.
+  ScanPose LatestPose() const;
 
   const std::vector<LoopClosure>& loops() const { return loops_; }
   /// The observed area of a completed submap: the cells of its stability grid G that some beam
@@ -235,6 +238,8 @@ class OnlineSlam {
     Pose2 icp;
     int submap = -1;
   };
+  ScanPose PoseOf(const ScanRecord& record) const;
+
   std::vector<ScanRecord> scans_;
   std::size_t first_pending_scan_ = 0;  // scans_ from here belong to the submap in progress
   double path_m_ = 0.0;

@@ -1,0 +1,101 @@
+"""What the live ROS 1 tests share (tests/ros/*_live_test.py): a private loopback ROS
+environment, a roscore on it with simulated time, processes started in their own sessions and
+killed by id, bounded waits, and the corrected poses of the FR079 log as truth."""
+
+import gzip
+import os
+import signal
+import socket
+import subprocess
+import time
+
+
+def free_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def corrected_poses(path):
+    """(stamp, x, y, theta) of every ROBOTLASER1 line: its ipc_timestamp and its robot pose."""
+    poses = []
+    with gzip.open(path, "rt") as log:
+        for line in log:
+            fields = line.split()
+            if not fields or fields[0] != "ROBOTLASER1":
+                continue
+            beams = int(fields[8])
+            rest = fields[9 + beams:]
+            remissions = int(rest[0])
+            rest = rest[1 + remissions:]
+            # laser x y theta, robot x y theta, tv rv forward side turn, ipc_timestamp ...
+            robot = [float(v) for v in rest[3:6]]
+            poses.append((float(rest[11]), robot[0], robot[1], robot[2]))
+    return poses
+
+
+class Processes:
+    """Processes started by the test, each in its own session, killed by id at the end."""
+
+    def __init__(self, env, log_dir):
+        self.env = env
+        self.log_dir = log_dir
+        self.started = []
+
+    def start(self, name, command):
+        log = open(os.path.join(self.log_dir, name + ".log"), "w")
+        process = subprocess.Popen(command, env=self.env, stdout=log, stderr=subprocess.STDOUT,
+                                   start_new_session=True)
+        self.started.append((name, process, log))
+        return process
+
+    def stop(self, process, timeout_s=10.0):
+        if process.poll() is not None:
+            return
+        os.killpg(process.pid, signal.SIGINT)
+        try:
+            process.wait(timeout_s)
+        except subprocess.TimeoutExpired:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait(timeout_s)
+
+    def stop_all(self):
+        for _, process, log in reversed(self.started):
+            self.stop(process)
+            log.close()
+
+    def log_of(self, name):
+        with open(os.path.join(self.log_dir, name + ".log")) as log:
+            return log.read()
+
+
+def wait_for(condition, timeout_s, what):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if condition():
+            return
+        time.sleep(0.05)
+    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout_s, what))
+
+
+def ros_environment(work):
+    """A ROS environment on a free loopback port with its home and logs under `work`; this
+    process's own environment (for rospy) is set to it too."""
+    env = dict(os.environ)
+    env.update({"ROS_MASTER_URI": "http://127.0.0.1:%d" % free_port(), "ROS_IP": "127.0.0.1",
+                "ROS_HOSTNAME": "127.0.0.1", "ROS_HOME": work,
+                "ROS_LOG_DIR": os.path.join(work, "log")})
+    os.environ.update(env)
+    return env
+
+
+def start_roscore(processes, env):
+    """A roscore on env's port, online, with /use_sim_time set (rosbag play --clock)."""
+    roscore = processes.start("roscore", ["roscore", "-p", env["ROS_MASTER_URI"].split(":")[-1]])
+    import rosgraph  # after the environment names the private master
+
+    master = rosgraph.Master("/keyplace_live_test")
+    wait_for(lambda: master.is_online() or roscore.poll() is not None, 30, "roscore")
+    assert roscore.poll() is None, processes.log_of("roscore")
+    master.setParam("/use_sim_time", True)
+    return roscore
