@@ -11,17 +11,14 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
-#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "keyplace/localization/relocalization_node.hpp"
 #include "keyplace/store/map_file.hpp"
 #include "node_messages.hpp"
 #include "ros_support.hpp"
+#include "sensor_inputs.hpp"
 
 namespace keyplace::ros1 {
 namespace {
@@ -30,12 +27,11 @@ class RelocalizeNode {
  public:
   RelocalizeNode(ros::NodeHandle& node, ros::NodeHandle& private_node, const GlobalMap& map,
                  const Config& config)
-      : core_(map, config), tf_listener_(tf_buffer_) {
-    const BagInputConfig& input = config.input;
-    scan_subscriber_ = node.subscribe(input.scan_topic, 200, &RelocalizeNode::OnScan, this);
-    if (config.node.odometry == NodeOdometry::kTopic) {
-      odom_subscriber_ = node.subscribe(input.odom_topic, 500, &RelocalizeNode::OnOdometry, this);
-    }
+      : core_(map, config),
+        inputs_(node, core_.config(),
+                {[this](const OdometryInput& odometry) { Publish(core_.AddOdometry(odometry)); },
+                 [this](const ScanInput& scan) { Publish(core_.AddScan(scan)); },
+                 [this](double now_s) { Publish(core_.Tick(now_s)); }}) {
     initial_pose_publisher_ =
         node.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 5);
     diagnostics_publisher_ = node.advertise<diagnostic_msgs::DiagnosticArray>("diagnostics", 10);
@@ -43,12 +39,7 @@ class RelocalizeNode {
         private_node.advertiseService("relocalize", &RelocalizeNode::OnRelocalize, this);
     save_status_service_ =
         private_node.advertiseService("save_status", &RelocalizeNode::OnSaveStatus, this);
-    timer_ = node.createTimer(ros::Duration(0.1), &RelocalizeNode::OnTimer, this);
-    const std::string odometry = config.node.odometry == NodeOdometry::kTopic
-                                     ? odom_subscriber_.getTopic()
-                                     : "tf " + input.odom_frame + " -> " + input.base_frame;
-    ROS_INFO("keyplace: relocalizing on %s with odometry from %s; publishing %s",
-             scan_subscriber_.getTopic().c_str(), odometry.c_str(),
+    ROS_INFO("keyplace: relocalizing on %s; publishing %s", inputs_.Description().c_str(),
              PublishText(config.node.publish));
   }
 
@@ -75,36 +66,6 @@ class RelocalizeNode {
     return "?";
   }
 
-  void OnScan(const sensor_msgs::LaserScan::ConstPtr& message) {
-    try {
-      const Config& config = core_.config();
-      if (config.node.odometry == NodeOdometry::kTf) {
-        const std::optional<OdometryInput> odometry =
-            TfOdometryAt(message->header.stamp, config, tf_buffer_);
-        if (odometry) Publish(core_.AddOdometry(*odometry));
-      }
-      Publish(core_.AddScan(ScanInputOf(*message, config, tf_buffer_)));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: scan: %s", error.what());
-    }
-  }
-
-  void OnOdometry(const nav_msgs::Odometry::ConstPtr& message) {
-    try {
-      Publish(core_.AddOdometry(OdometryInputOf(*message)));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: odometry: %s", error.what());
-    }
-  }
-
-  void OnTimer(const ros::TimerEvent&) {
-    try {
-      Publish(core_.Tick(ros::Time::now().toSec()));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: %s", error.what());
-    }
-  }
-
   bool OnRelocalize(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
     Publish(core_.Relocalize());
     response.success = true;
@@ -129,9 +90,7 @@ class RelocalizeNode {
   void Publish(const NodeOutput& output) {
     LogEvents(output.events);
     for (const StampedInitialPose& fix : output.initial_poses) PublishInitialPose(fix);
-    for (const StampedTransform& transform : output.transforms) {
-      tf_broadcaster_.sendTransform(TransformMessageOf(transform));
-    }
+    for (const StampedTransform& transform : output.transforms) inputs_.Broadcast(transform);
     if (output.status_due) PublishStatus();
   }
 
@@ -190,16 +149,11 @@ class RelocalizeNode {
   }
 
   RelocalizationNode core_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
-  ros::Subscriber scan_subscriber_;
-  ros::Subscriber odom_subscriber_;
+  SensorInputs inputs_;
   ros::Publisher initial_pose_publisher_;
   ros::Publisher diagnostics_publisher_;
   ros::ServiceServer relocalize_service_;
   ros::ServiceServer save_status_service_;
-  ros::Timer timer_;
 };
 
 }  // namespace

@@ -9,16 +9,13 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <nav_msgs/OccupancyGrid.h>
-#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "keyplace/slam/slam_node.hpp"
 #include "node_messages.hpp"
 #include "ros_support.hpp"
+#include "sensor_inputs.hpp"
 
 namespace keyplace::ros1 {
 namespace {
@@ -57,22 +54,16 @@ nav_msgs::OccupancyGrid GridMessageOf(const StampedGrid& stamped,
 class SlamRosNode {
  public:
   SlamRosNode(ros::NodeHandle& node, ros::NodeHandle& private_node, const Config& config)
-      : core_(config), tf_listener_(tf_buffer_) {
-    const BagInputConfig& input = config.input;
-    scan_subscriber_ = node.subscribe(input.scan_topic, 200, &SlamRosNode::OnScan, this);
-    if (config.node.odometry == NodeOdometry::kTopic) {
-      odom_subscriber_ = node.subscribe(input.odom_topic, 500, &SlamRosNode::OnOdometry, this);
-    }
+      : core_(config),
+        inputs_(node, core_.config(),
+                {[this](const OdometryInput& odometry) { Publish(core_.AddOdometry(odometry)); },
+                 [this](const ScanInput& scan) { Publish(core_.AddScan(scan)); },
+                 [this](double now_s) { Publish(core_.Tick(now_s)); }}) {
     map_publisher_ = node.advertise<nav_msgs::OccupancyGrid>("map", 1, /*latch=*/true);
     diagnostics_publisher_ = node.advertise<diagnostic_msgs::DiagnosticArray>("diagnostics", 10);
     save_map_service_ = private_node.advertiseService("save_map", &SlamRosNode::OnSaveMap, this);
-    timer_ = node.createTimer(ros::Duration(0.1), &SlamRosNode::OnTimer, this);
-    ROS_INFO("keyplace: SLAM on %s with odometry from %s; /map every %.1f s, ~save_map to %s",
-             scan_subscriber_.getTopic().c_str(),
-             config.node.odometry == NodeOdometry::kTopic
-                 ? odom_subscriber_.getTopic().c_str()
-                 : ("tf " + input.odom_frame + " -> " + input.base_frame).c_str(),
-             config.node.map_period_s, config.node.map_path.c_str());
+    ROS_INFO("keyplace: SLAM on %s; /map every %.1f s, ~save_map to %s",
+             inputs_.Description().c_str(), config.node.map_period_s, config.node.map_path.c_str());
   }
 
   ~SlamRosNode() {
@@ -86,36 +77,6 @@ class SlamRosNode {
   }
 
  private:
-  void OnScan(const sensor_msgs::LaserScan::ConstPtr& message) {
-    try {
-      const Config& config = core_.config();
-      if (config.node.odometry == NodeOdometry::kTf) {
-        const std::optional<OdometryInput> odometry =
-            TfOdometryAt(message->header.stamp, config, tf_buffer_);
-        if (odometry) Publish(core_.AddOdometry(*odometry));
-      }
-      Publish(core_.AddScan(ScanInputOf(*message, config, tf_buffer_)));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: scan: %s", error.what());
-    }
-  }
-
-  void OnOdometry(const nav_msgs::Odometry::ConstPtr& message) {
-    try {
-      Publish(core_.AddOdometry(OdometryInputOf(*message)));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: odometry: %s", error.what());
-    }
-  }
-
-  void OnTimer(const ros::TimerEvent&) {
-    try {
-      Publish(core_.Tick(ros::Time::now().toSec()));
-    } catch (const std::exception& error) {
-      ROS_ERROR("keyplace: %s", error.what());
-    }
-  }
-
   bool OnSaveMap(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
     try {
       const SavedSlamMap saved = core_.SaveMap(core_.config().node.map_path);
@@ -133,9 +94,7 @@ class SlamRosNode {
 
   void Publish(const SlamNodeOutput& output) {
     LogEvents(output.events);
-    for (const StampedTransform& transform : output.transforms) {
-      tf_broadcaster_.sendTransform(TransformMessageOf(transform));
-    }
+    for (const StampedTransform& transform : output.transforms) inputs_.Broadcast(transform);
     if (output.map) map_publisher_.publish(GridMessageOf(*output.map, core_.config().grid));
     if (output.status_due) PublishStatus();
   }
@@ -176,15 +135,10 @@ class SlamRosNode {
   }
 
   SlamNode core_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
-  ros::Subscriber scan_subscriber_;
-  ros::Subscriber odom_subscriber_;
+  SensorInputs inputs_;
   ros::Publisher map_publisher_;
   ros::Publisher diagnostics_publisher_;
   ros::ServiceServer save_map_service_;
-  ros::Timer timer_;
 };
 
 }  // namespace

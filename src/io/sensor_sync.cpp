@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <iterator>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
+#include "common/fixed_text.hpp"
 #include "keyplace/io/carmen_log.hpp"
 
 namespace keyplace {
@@ -16,17 +15,6 @@ namespace {
 // An odometry position beyond this is a corrupt message, not a place (the log and bag readers'
 // limit, CarmenReadOptions::max_coordinate_m).
 constexpr double kMaxCoordinateM = 1e7;
-
-std::string Number(double value, int decimals = 3) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(decimals) << value;
-  return text.str();
-}
-
-std::string PoseText(const Pose2& pose) {
-  return Number(pose.x) + " m, " + Number(pose.y) + " m, " + Number(pose.theta * 180.0 / M_PI, 1) +
-         " deg";
-}
 
 // x and y linearly, the heading along the shorter turn (as the bag readers interpolate).
 Pose2 Interpolate(const OdometryInput& a, const OdometryInput& b, double stamp_s) {
@@ -41,8 +29,9 @@ Pose2 Interpolate(const OdometryInput& a, const OdometryInput& b, double stamp_s
 std::string GeometryText(const ScanInput& geometry) {
   return "frame '" + geometry.frame_id + "', " +
          std::to_string(static_cast<std::size_t>(geometry.stamp_s)) + " beams from " +
-         Number(geometry.angle_min_rad, 6) + " rad by " + Number(geometry.angle_increment_rad, 6) +
-         " rad, ranges " + Number(geometry.range_min_m) + " to " + Number(geometry.range_max_m) +
+         FixedText(geometry.angle_min_rad, 6) + " rad by " +
+         FixedText(geometry.angle_increment_rad, 6) + " rad, ranges " +
+         FixedText(geometry.range_min_m) + " to " + FixedText(geometry.range_max_m) +
          " m, laser at " + PoseText(*geometry.T_robot_laser);
 }
 
@@ -65,11 +54,11 @@ std::string BearingProblem(double start_rad, double step_rad, std::size_t beams)
     return "angle_min and angle_increment must be finite";
   }
   if (!(std::abs(start_rad) <= 2.0 * M_PI)) {
-    return "angle_min = " + Number(start_rad, 6) + " rad is not an angle in [-2 pi, 2 pi]";
+    return "angle_min = " + FixedText(start_rad, 6) + " rad is not an angle in [-2 pi, 2 pi]";
   }
   const double span_rad = std::abs(step_rad) * static_cast<double>(beams - 1);
   if ((beams > 1 && step_rad == 0.0) || !(span_rad <= 2.0 * M_PI * (1.0 + 1e-9))) {
-    return "angle_increment = " + Number(step_rad, 6) + " rad over " + std::to_string(beams) +
+    return "angle_increment = " + FixedText(step_rad, 6) + " rad over " + std::to_string(beams) +
            " beams does not spread them over at most one turn";
   }
   return "";
@@ -77,7 +66,7 @@ std::string BearingProblem(double start_rad, double step_rad, std::size_t beams)
 
 }  // namespace
 
-std::string StampText(double stamp_s) { return Number(stamp_s, 6); }
+std::string StampText(double stamp_s) { return FixedText(stamp_s, 6); }
 
 SensorSync::SensorSync(const BagInputConfig& input, double odometry_wait_s)
     : input_([&] {
@@ -237,7 +226,7 @@ void SensorSync::Drain(SyncOutput& output) {
   while (!pending_.empty() && last_scan_stamp_s_ &&
          pending_.front().scan.timestamp_s < *last_scan_stamp_s_ - odometry_wait_s_) {
     Drop("scan at " + StampText(pending_.front().scan.timestamp_s) + " dropped: no odometry at " +
-             "its stamp within node.odometry_wait_s (" + Number(odometry_wait_s_) + " s)",
+             "its stamp within node.odometry_wait_s (" + FixedText(odometry_wait_s_) + " s)",
          output);
     pending_.pop_front();
   }

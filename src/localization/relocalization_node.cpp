@@ -3,33 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <iomanip>
 #include <limits>
 #include <sstream>
 #include <utility>
 
+#include "common/fixed_text.hpp"
 #include "common/latency_window.hpp"
 #include "common/period.hpp"
 #include "io/atomic_file.hpp"
 
 namespace keyplace {
-namespace {
-
-std::string Number(double value, int decimals = 3) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(decimals) << value;
-  return text.str();
-}
-
-std::string PoseText(const Pose2& pose) {
-  return Number(pose.x) + " m, " + Number(pose.y) + " m, " + Number(pose.theta * 180.0 / M_PI, 1) +
-         " deg";
-}
-
-}  // namespace
-
 RelocalizationNode::RelocalizationNode(const GlobalMap& map, const Config& config)
     : config_([&] {
         Validate(config);
@@ -89,7 +74,7 @@ void RelocalizationNode::Process(const LaserScan& scan, const Pose2& T_odom_robo
     if (step_m > config_.localization.fix.lost_after_m) {
       output.events.push_back(
           {NodeEventLevel::kWarning,
-           at + ": the odometry moved " + Number(step_m) + " m since the previous scan (more " +
+           at + ": the odometry moved " + FixedText(step_m) + " m since the previous scan (more " +
                "than localization.fix.lost_after_m): fix and query forgotten, searching again"});
       if (status_.status == FixStatus::kFixed) ++status_.losses;
       relocalizer_.Reset();
@@ -152,7 +137,7 @@ void RelocalizationNode::Publish(const RelocalizationUpdate& update, double stam
     ++status_.fixes;
     output.events.push_back(
         {NodeEventLevel::kInfo, at + ": fixed at " + PoseText(update.T_world_robot) +
-                                    ", confidence " + Number(update.confidence)});
+                                    ", confidence " + FixedText(update.confidence)});
     if (publish != NodePublish::kMapToOdom)
       output.initial_poses.push_back({stamp_s, *status_.pose});
   }

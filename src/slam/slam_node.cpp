@@ -3,11 +3,10 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <iomanip>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
+#include "common/fixed_text.hpp"
 #include "common/latency_window.hpp"
 #include "common/period.hpp"
 #include "keyplace/mapping/map_server.hpp"
@@ -15,12 +14,6 @@
 
 namespace keyplace {
 namespace {
-
-std::string Fixed(double value, int decimals) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(decimals) << value;
-  return text.str();
-}
 
 double CpuSecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -82,9 +75,9 @@ Pose2 SlamNode::ContinuousOdometry(const SyncedScan& synced, SlamNodeOutput& out
       output.events.push_back(
           {NodeEventLevel::kWarning,
            "scan at " + StampText(synced.scan.timestamp_s) + ": the odometry moved " +
-               Fixed(TranslationNorm(step), 3) + " m in " + Fixed(dt_s, 3) + " s (more than " +
-               Fixed(allowed_m, 3) + " m): a reset or a glitch of the odometry, not motion; " +
-               "absorbed"});
+               FixedText(TranslationNorm(step), 3) + " m in " + FixedText(dt_s, 3) +
+               " s (more than " + FixedText(allowed_m, 3) +
+               " m): a reset or a glitch of the odometry, not motion; " + "absorbed"});
       T_continuous_odom_ = T_continuous_odom_ * *last_T_odom_robot_ * T_odom_robot.inverse();
     }
   }

@@ -52,21 +52,6 @@ Config NodeTestConfig(NodePublish publish = NodePublish::kInitialPose) {
   return config;
 }
 
-// Scan k of the bundled log as a driver sends it.
-ScanInput ScanMessage(std::size_t k) {
-  const LogScan& scan = BundledFr079().inputs.log.scans[k];
-  ScanInput input;
-  input.stamp_s = scan.timestamp_s;
-  input.frame_id = "laser";
-  input.angle_min_rad = scan.angles_rad.front();
-  input.angle_increment_rad = scan.angles_rad[1] - scan.angles_rad[0];
-  input.range_min_m = 0.0;
-  input.range_max_m = scan.max_range_m;
-  for (const double range_m : scan.ranges_m) input.ranges_m.push_back(static_cast<float>(range_m));
-  input.T_robot_laser = scan.T_robot_laser;
-  return input;
-}
-
 OdometryInput OdometryMessage(std::size_t k) {
   return {BundledFr079().inputs.log.scans[k].timestamp_s,
           kT_odom_world * BundledFr079().inputs.poses[k]};
@@ -98,7 +83,7 @@ NodeRun Stream(RelocalizationNode& node, std::size_t begin, std::size_t end,
   std::optional<std::size_t> stop;
   for (std::size_t k = begin; k < end && (!stop || k < *stop); ++k) {
     run.Add(node.AddOdometry(OdometryMessage(k)));
-    run.Add(node.AddScan(ScanMessage(k)));
+    run.Add(node.AddScan(testing::BundledScanMessage(k)));
     const bool fixed = !run.statuses.empty() && run.statuses.back() == FixStatus::kFixed;
     if (extra && !stop && fixed) stop = k + 1 + *extra;
   }
@@ -219,23 +204,25 @@ TEST(RelocalizationNode, AScanWaitsForOdometryAtItsStampAndIsDroppedWhenALaterOn
   RelocalizationNode node(FirstHalfMap(), NodeTestConfig());
   const std::size_t k = kMapScans;
   node.AddOdometry(OdometryMessage(k - 1));
-  NodeOutput output = node.AddScan(ScanMessage(k));
+  NodeOutput output = node.AddScan(testing::BundledScanMessage(k));
   EXPECT_TRUE(output.scans.empty()) << "no odometry at its stamp yet";
   output = node.AddOdometry(OdometryMessage(k));
   ASSERT_EQ(output.scans.size(), 1U) << "processed when the odometry arrives";
-  EXPECT_EQ(output.scans.front().stamp_s, ScanMessage(k).stamp_s);
+  EXPECT_EQ(output.scans.front().stamp_s, testing::BundledScanMessage(k).stamp_s);
 
   // The next scans get no odometry: the first is dropped when a scan node.odometry_wait_s (1 s)
   // newer comes; the clock drops nothing (its scan's odometry may still be queued).
-  node.AddScan(ScanMessage(k + 1));
-  output = node.Tick(ScanMessage(k + 1).stamp_s + 10.0);
+  node.AddScan(testing::BundledScanMessage(k + 1));
+  output = node.Tick(testing::BundledScanMessage(k + 1).stamp_s + 10.0);
   EXPECT_TRUE(output.events.empty());
   EXPECT_EQ(node.status().scans_waiting, 1U);
   EXPECT_TRUE(output.status_due) << "the status goes out every node.status_period_s";
-  ASSERT_LT(ScanMessage(k + 2).stamp_s - ScanMessage(k + 1).stamp_s, 1.0);
-  EXPECT_TRUE(node.AddScan(ScanMessage(k + 2)).events.empty());
-  ASSERT_GT(ScanMessage(k + 3).stamp_s - ScanMessage(k + 1).stamp_s, 1.0);
-  output = node.AddScan(ScanMessage(k + 3));
+  ASSERT_LT(testing::BundledScanMessage(k + 2).stamp_s - testing::BundledScanMessage(k + 1).stamp_s,
+            1.0);
+  EXPECT_TRUE(node.AddScan(testing::BundledScanMessage(k + 2)).events.empty());
+  ASSERT_GT(testing::BundledScanMessage(k + 3).stamp_s - testing::BundledScanMessage(k + 1).stamp_s,
+            1.0);
+  output = node.AddScan(testing::BundledScanMessage(k + 3));
   ASSERT_EQ(output.events.size(), 1U);
   testing::ExpectContains(output.events.front().what, "no odometry at its stamp");
   EXPECT_EQ(node.status().scans_dropped, 1U);
@@ -253,9 +240,10 @@ TEST(RelocalizationNode, ScansBehindTheOdometryAreProcessedInTheirOrder) {
   RelocalizationNode node(FirstHalfMap(), NodeTestConfig());
   const std::size_t k = kMapScans;
   for (std::size_t i = k; i < k + 20; ++i) node.AddOdometry(OdometryMessage(i));
-  ASSERT_GT(ScanMessage(k + 19).stamp_s - ScanMessage(k).stamp_s, 5.0);
+  ASSERT_GT(testing::BundledScanMessage(k + 19).stamp_s - testing::BundledScanMessage(k).stamp_s,
+            5.0);
   for (std::size_t i = k; i < k + 20; ++i) {
-    const NodeOutput output = node.AddScan(ScanMessage(i));
+    const NodeOutput output = node.AddScan(testing::BundledScanMessage(i));
     ASSERT_EQ(output.scans.size(), 1U) << "scan " << i;
     for (const NodeEvent& event : output.events) {
       EXPECT_EQ(event.level, NodeEventLevel::kInfo) << event.what;
@@ -272,35 +260,35 @@ TEST(RelocalizationNode, HostileInputsAreEventsAndTheNodeStillFixesAfterThem) {
     events.insert(events.end(), output.events.begin(), output.events.end());
   };
   note(node.AddOdometry(OdometryMessage(k)));
-  note(node.AddScan(ScanMessage(k)));
+  note(node.AddScan(testing::BundledScanMessage(k)));
 
-  ScanInput empty = ScanMessage(++k);
+  ScanInput empty = testing::BundledScanMessage(++k);
   empty.ranges_m.clear();
   note(node.AddOdometry(OdometryMessage(k)));
   note(node.AddScan(empty));
   EXPECT_TRUE(HasEvent(events, "it has no beams"));
 
-  ScanInput too_many = ScanMessage(++k);
+  ScanInput too_many = testing::BundledScanMessage(++k);
   too_many.ranges_m.assign(9000, 5.0F);
   too_many.angle_increment_rad = 2.0 * M_PI / 9000.0;
   note(node.AddOdometry(OdometryMessage(k)));
   note(node.AddScan(too_many));
   EXPECT_TRUE(HasEvent(events, "9000 beams, more than the 8192"));
 
-  ScanInput all_nan = ScanMessage(++k);
+  ScanInput all_nan = testing::BundledScanMessage(++k);
   all_nan.ranges_m.assign(all_nan.ranges_m.size(), std::numeric_limits<float>::quiet_NaN());
   note(node.AddOdometry(OdometryMessage(k)));
   const NodeOutput nan_output = node.AddScan(all_nan);
   note(nan_output);
   EXPECT_EQ(nan_output.scans.size(), 1U) << "a scan of NaN ranges is processed, no beam valid";
 
-  ScanInput no_laser_pose = ScanMessage(++k);
+  ScanInput no_laser_pose = testing::BundledScanMessage(++k);
   no_laser_pose.T_robot_laser.reset();
   note(node.AddOdometry(OdometryMessage(k)));
   note(node.AddScan(no_laser_pose));
   EXPECT_TRUE(HasEvent(events, "no laser pose for frame 'laser'"));
 
-  note(node.AddScan(ScanMessage(k - 3)));  // an old stamp
+  note(node.AddScan(testing::BundledScanMessage(k - 3)));  // an old stamp
   EXPECT_TRUE(HasEvent(events, "out of order or repeated"));
 
   OdometryInput bad_odometry = OdometryMessage(k);
@@ -310,7 +298,7 @@ TEST(RelocalizationNode, HostileInputsAreEventsAndTheNodeStillFixesAfterThem) {
   EXPECT_TRUE(HasEvent(events, "is not finite"));
 
   // The scanner changes: half the beams over the same field of view.
-  ScanInput coarse = ScanMessage(++k);
+  ScanInput coarse = testing::BundledScanMessage(++k);
   std::vector<float> every_other;
   for (std::size_t i = 0; i < coarse.ranges_m.size(); i += 2)
     every_other.push_back(coarse.ranges_m[i]);
@@ -325,7 +313,7 @@ TEST(RelocalizationNode, HostileInputsAreEventsAndTheNodeStillFixesAfterThem) {
   OdometryInput jump = OdometryMessage(k);
   jump.T_odom_robot = Pose2(1e5, 0.0, 0.0) * jump.T_odom_robot;
   note(node.AddOdometry(jump));
-  const NodeOutput jump_output = node.AddScan(ScanMessage(k));
+  const NodeOutput jump_output = node.AddScan(testing::BundledScanMessage(k));
   note(jump_output);
   EXPECT_EQ(jump_output.scans.size(), 1U);
   EXPECT_TRUE(HasEvent(events, "searching again"));
@@ -338,7 +326,7 @@ TEST(RelocalizationNode, HostileInputsAreEventsAndTheNodeStillFixesAfterThem) {
     OdometryInput odometry = OdometryMessage(k);
     odometry.T_odom_robot = Pose2(1e5, 0.0, 0.0) * odometry.T_odom_robot;
     run.Add(node.AddOdometry(odometry));
-    run.Add(node.AddScan(ScanMessage(k)));
+    run.Add(node.AddScan(testing::BundledScanMessage(k)));
   }
   ASSERT_EQ(run.initial_poses.size(), 1U);
   ExpectNearTruth(run.initial_poses.front().pose.T_map_robot,

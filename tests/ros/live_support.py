@@ -99,3 +99,37 @@ def start_roscore(processes, env):
     assert roscore.poll() is None, processes.log_of("roscore")
     master.setParam("/use_sim_time", True)
     return roscore
+
+
+def collect_statuses(status_name):
+    """Subscribes to /diagnostics; returns the list the statuses named `status_name` (suffix) are
+    appended to, as (wall time, {key: value}) in arrival order."""
+    import rospy
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    statuses = []
+
+    def on_diagnostics(message):
+        for status in message.status:
+            if status.name.endswith(status_name):
+                statuses.append((time.monotonic(),
+                                 {entry.key: entry.value for entry in status.values}))
+
+    rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=1000)
+    return statuses
+
+
+def wait_for_service(service, node, processes):
+    """Waits (30 s at most) until the node offers `service` (a rospy.ServiceProxy); fails with the
+    node's log if it exits first."""
+    import rospy
+
+    def node_up():
+        try:
+            service.wait_for_service(0.2)
+            return True
+        except rospy.ROSException:
+            return node.poll() is not None
+
+    wait_for(node_up, 30, "the node's services")
+    assert node.poll() is None, processes.log_of("node")

@@ -22,8 +22,8 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from live_support import (Processes, corrected_poses, ros_environment, start_roscore,  # noqa: E402
-                          wait_for)
+from live_support import (Processes, collect_statuses, corrected_poses,  # noqa: E402
+                          ros_environment, start_roscore, wait_for, wait_for_service)
 
 MAP_SCANS = "0:732"     # corrected scans of the map: raw scans 0..2465, bag time up to 1743.1 s
 PLAY_START_S = 532.0    # bag offset of raw scan 2466 (1743.6 s; the bag starts at 1211.52 s)
@@ -68,7 +68,6 @@ def main():
 def run(args, processes, env, work, map_path, bag, truth_log):
     start_roscore(processes, env)
     import rospy
-    from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseWithCovarianceStamped
     from std_srvs.srv import Trigger
 
@@ -82,31 +81,11 @@ def run(args, processes, env, work, map_path, bag, truth_log):
 
     rospy.init_node("keyplace_live_test", anonymous=True, disable_signals=True)
     fixes = []
-    statuses = []  # (wall time, status dict) in arrival order
-
-    def on_initial_pose(message):
-        fixes.append(message)
-
-    def on_diagnostics(message):
-        for status in message.status:
-            if status.name.endswith("keyplace_relocalize: relocalization"):
-                statuses.append((time.monotonic(),
-                                 {entry.key: entry.value for entry in status.values}))
-
-    rospy.Subscriber("/initialpose", PoseWithCovarianceStamped, on_initial_pose, queue_size=100)
-    rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=1000)
+    rospy.Subscriber("/initialpose", PoseWithCovarianceStamped, fixes.append, queue_size=100)
+    statuses = collect_statuses("keyplace_relocalize: relocalization")
     relocalize = rospy.ServiceProxy("/keyplace_relocalize/relocalize", Trigger)
     save_status = rospy.ServiceProxy("/keyplace_relocalize/save_status", Trigger)
-
-    def node_up():
-        try:
-            relocalize.wait_for_service(0.2)
-            return True
-        except rospy.ROSException:
-            return node.poll() is not None
-
-    wait_for(node_up, 30, "the node's services")
-    assert node.poll() is None, processes.log_of("node")
+    wait_for_service(relocalize, node, processes)
     time.sleep(0.5)  # the subscriptions connect
 
     play_started = time.monotonic()

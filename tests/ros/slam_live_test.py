@@ -22,8 +22,8 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from live_support import (Processes, corrected_poses, ros_environment, start_roscore,  # noqa: E402
-                          wait_for)
+from live_support import (Processes, collect_statuses, corrected_poses,  # noqa: E402
+                          ros_environment, start_roscore, wait_for, wait_for_service)
 
 # The bag's converter wrote the laser at x = +0.04 m and beams pi/359 apart; the log has -0.04 m
 # and pi/360 (docs/ROS.md, "Checked against a real bag").
@@ -58,7 +58,6 @@ def main():
 def run(args, processes, work, bag, truth_log):
     start_roscore(processes, processes.env)
     import rospy
-    from diagnostic_msgs.msg import DiagnosticArray
     from nav_msgs.msg import OccupancyGrid
     from std_srvs.srv import Trigger
 
@@ -72,30 +71,10 @@ def run(args, processes, work, bag, truth_log):
 
     rospy.init_node("keyplace_slam_live_test", anonymous=True, disable_signals=True)
     maps = []
-    statuses = []  # (wall time, status dict) in arrival order
-
-    def on_map(message):
-        maps.append(message)
-
-    def on_diagnostics(message):
-        for status in message.status:
-            if status.name.endswith("keyplace_slam: slam"):
-                statuses.append((time.monotonic(),
-                                 {entry.key: entry.value for entry in status.values}))
-
-    rospy.Subscriber("/map", OccupancyGrid, on_map, queue_size=10)
-    rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=1000)
+    rospy.Subscriber("/map", OccupancyGrid, maps.append, queue_size=10)
+    statuses = collect_statuses("keyplace_slam: slam")
     save_map = rospy.ServiceProxy("/keyplace_slam/save_map", Trigger)
-
-    def node_up():
-        try:
-            save_map.wait_for_service(0.2)
-            return True
-        except rospy.ROSException:
-            return node.poll() is not None
-
-    wait_for(node_up, 30, "the node's services")
-    assert node.poll() is None, processes.log_of("node")
+    wait_for_service(save_map, node, processes)
     early = save_map()
     assert not early.success and "no submap completed yet" in early.message, early
     time.sleep(0.5)  # the subscriptions connect

@@ -31,19 +31,6 @@ constexpr std::size_t kScans = 500;
 // The robot's odometry frame is not the truth's.
 const Pose2 kT_odom_world(3.0, -7.0, 0.8);
 
-ScanInput ScanMessage(std::size_t k) {
-  const LogScan& scan = BundledFr079().inputs.log.scans[k];
-  ScanInput input;
-  input.stamp_s = scan.timestamp_s;
-  input.frame_id = "laser";
-  input.angle_min_rad = scan.angles_rad.front();
-  input.angle_increment_rad = scan.angles_rad[1] - scan.angles_rad[0];
-  input.range_max_m = scan.max_range_m;
-  for (const double range_m : scan.ranges_m) input.ranges_m.push_back(static_cast<float>(range_m));
-  input.T_robot_laser = scan.T_robot_laser;
-  return input;
-}
-
 Pose2 TrueOdometry(std::size_t k) { return kT_odom_world * BundledFr079().inputs.poses[k]; }
 
 struct SlamNodeRun {
@@ -71,7 +58,7 @@ SlamNodeRun Stream(SlamNode& node, std::size_t scans, std::size_t jump_at = 0,
     const double stamp_s = BundledFr079().inputs.log.scans[k].timestamp_s;
     run.Add(node.AddOdometry({stamp_s, T_odom_robot}));
     const std::size_t processed = node.status().scans_processed;
-    SlamNodeOutput output = node.AddScan(ScanMessage(k));
+    SlamNodeOutput output = node.AddScan(testing::BundledScanMessage(k));
     if (node.status().scans_processed > processed) {
       EXPECT_EQ(output.transforms.front().stamp_s, stamp_s);
       run.T_map_odom.push_back(output.transforms.front().T_parent_child);
@@ -172,7 +159,7 @@ TEST(SlamNode, MapGoesOutEveryPeriodWithTheWallsOfTheLog) {
   EXPECT_EQ(idle.transforms.front().stamp_s, end_s + 120.0);
   EXPECT_TRUE(node.Tick(end_s + 120.5).transforms.empty());
   node.AddOdometry({end_s + 121.0, TrueOdometry(kFew - 1)});
-  ScanInput scan = ScanMessage(kFew);
+  ScanInput scan = testing::BundledScanMessage(kFew);
   scan.stamp_s = end_s + 121.0;
   EXPECT_EQ(node.AddScan(scan).transforms.size(), 1U);
   EXPECT_TRUE(node.Tick(end_s + 121.5).transforms.empty());
@@ -239,13 +226,13 @@ TEST(SlamNode, HostileScansAreDroppedAndMappingGoesOn) {
   SlamNode node(config);
   Stream(node, 50);
   const double stamp_s = BundledFr079().inputs.log.scans[49].timestamp_s;
-  ScanInput empty = ScanMessage(50);
+  ScanInput empty = testing::BundledScanMessage(50);
   empty.stamp_s = stamp_s + 0.01;
   empty.ranges_m.clear();
-  ScanInput huge = ScanMessage(50);
+  ScanInput huge = testing::BundledScanMessage(50);
   huge.stamp_s = stamp_s + 0.02;
   huge.ranges_m.assign(9000, 1.0F);
-  ScanInput nan = ScanMessage(50);
+  ScanInput nan = testing::BundledScanMessage(50);
   nan.stamp_s = stamp_s + 0.03;
   nan.ranges_m.assign(nan.ranges_m.size(), std::nanf(""));
   for (const ScanInput& scan : {empty, huge, nan}) EXPECT_NO_THROW(node.AddScan(scan));

@@ -32,4 +32,18 @@ std::vector<LocalizationQuery> BundledQueriesEvery(std::size_t step) {
                             PlaceRecognitionConfig{}.query_keypoints);
 }
 
+ScanInput BundledScanMessage(std::size_t k) {
+  const LogScan& scan = BundledFr079().inputs.log.scans.at(k);
+  ScanInput input;
+  input.stamp_s = scan.timestamp_s;
+  input.frame_id = "laser";
+  input.angle_min_rad = scan.angles_rad.front();
+  input.angle_increment_rad = scan.angles_rad[1] - scan.angles_rad[0];
+  input.range_min_m = 0.0;
+  input.range_max_m = scan.max_range_m;
+  for (const double range_m : scan.ranges_m) input.ranges_m.push_back(static_cast<float>(range_m));
+  input.T_robot_laser = scan.T_robot_laser;
+  return input;
+}
+
 }  // namespace keyplace::testing

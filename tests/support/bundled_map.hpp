@@ -7,6 +7,7 @@
 
 #include "keyplace/eval/global_localization.hpp"
 #include "keyplace/eval/ground_truth.hpp"
+#include "keyplace/io/sensor_input.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/mapping/scan_sources.hpp"
 
@@ -19,6 +20,10 @@ struct BundledMap {
 };
 
 const BundledMap& BundledFr079();
+
+/// Scan k of the bundled log as a laser driver sends it (sensor_msgs/LaserScan's fields, frame
+/// "laser", the log's mounting as the laser pose tf gives).
+ScanInput BundledScanMessage(std::size_t k);
 
 /// Every step-th of the bundled log's submap queries (Algorithm 4, QueryStarts of 500, default
 /// query keypoints), built for those starts only: BuildSubmapQueries builds each start's query
