@@ -59,7 +59,7 @@ NodeOutput RelocalizationNode::Relocalize() {
   return output;
 }
 
-void RelocalizationNode::Release(SyncOutput synced, NodeOutput& output) {
+void RelocalizationNode::Release(const SyncOutput& synced, NodeOutput& output) {
   output.events.insert(output.events.end(), synced.events.begin(), synced.events.end());
   for (const SyncedScan& next : synced.scans) Process(next.scan, next.T_odom_robot, output);
 }

@@ -57,7 +57,7 @@ SlamNodeOutput SlamNode::Tick(double now_s) {
   return output;
 }
 
-void SlamNode::Release(SyncOutput synced, SlamNodeOutput& output) {
+void SlamNode::Release(SyncOutput&& synced, SlamNodeOutput& output) {
   output.events.insert(output.events.end(), synced.events.begin(), synced.events.end());
   for (SyncedScan& next : synced.scans) Process(next, output);
 }

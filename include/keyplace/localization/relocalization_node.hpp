@@ -120,7 +120,7 @@ class RelocalizationNode {
   void SaveStatus(const std::string& path) const;
 
  private:
-  void Release(SyncOutput synced, NodeOutput& output);
+  void Release(const SyncOutput& synced, NodeOutput& output);
   void Process(const LaserScan& scan, const Pose2& T_odom_robot, NodeOutput& output);
   void Publish(const RelocalizationUpdate& update, double stamp_s, NodeOutput& output);
   // The status every node.status_period_s; map -> odom when the wrapper's clock finds none sent

@@ -110,7 +110,7 @@ class SlamNode {
   const Config& config() const { return config_; }
 
  private:
-  void Release(SyncOutput synced, SlamNodeOutput& output);
+  void Release(SyncOutput&& synced, SlamNodeOutput& output);
   void Process(SyncedScan& synced, SlamNodeOutput& output);
   // The odometry pose SLAM is given: `T_odom_robot` with the jumps absorbed so far.
   Pose2 ContinuousOdometry(const SyncedScan& synced, SlamNodeOutput& output);
