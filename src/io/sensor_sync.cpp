@@ -134,11 +134,6 @@ SyncOutput SensorSync::AddScan(const ScanInput& input) {
   return output;
 }
 
-void SensorSync::Clear() {
-  pending_.clear();
-  odometry_.clear();
-}
-
 std::optional<LaserScan> SensorSync::Convert(const ScanInput& input, SyncOutput& output) {
   const std::size_t n = input.ranges_m.size();
   const double fov_rad = input_.scan_fov_rad;

@@ -40,6 +40,16 @@ void Validate(const NodeConfig& config) {
     fail("map_period_s must be in (0, 3600] s");
   }
   if (config.map_path.empty()) fail("map_path must not be empty");
+  // The grid goes beside the map as .yaml and .pgm: a map of that name would be overwritten.
+  for (const char* grid_extension : {".yaml", ".pgm"}) {
+    const std::string extension(grid_extension);
+    if (config.map_path.size() >= extension.size() &&
+        config.map_path.compare(config.map_path.size() - extension.size(), extension.size(),
+                                extension) == 0) {
+      fail("map_path '" + config.map_path + "' ends in " + extension +
+           ": that is where the map_server grid goes (use .kpm)");
+    }
+  }
 }
 
 const ConfigFields<NodeConfig>& NodeConfigFields() {

@@ -95,7 +95,20 @@ SlamStep OnlineSlam::AddScan(int scan_index, const LaserScan& scan,
   stats_.seconds_odometry += SecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  const bool complete = mapper_.AddScan(scan_index, scan, pose, keypoints);
+  bool complete = false;
+  try {
+    complete = mapper_.AddScan(scan_index, scan, pose, keypoints);
+  } catch (...) {
+    // The mapper is as it was (it checks before it changes anything): so is the submap in
+    // progress, and a caller that goes on (a robot node) maps on with the next scan.
+    scans_.pop_back();
+    pending_points_.pop_back();
+    pending_keypoints_.pop_back();
+    --stats_.scans;
+    map_.source_scans = stats_.scans;
+    map_.source_keypoints -= keypoints.size();
+    throw;
+  }
   stats_.seconds_mapping += SecondsSince(start);
   if (complete) CompleteSubmap(step);
   return step;

@@ -64,24 +64,29 @@ void SlamNode::Release(SyncOutput&& synced, SlamNodeOutput& output) {
 
 Pose2 SlamNode::ContinuousOdometry(const SyncedScan& synced, SlamNodeOutput& output) {
   const Pose2& T_odom_robot = synced.T_odom_robot;
+  const double stamp_s = synced.scan.timestamp_s;
   if (last_T_odom_robot_) {
-    const double dt_s = synced.scan.timestamp_s - status_.last_scan_stamp_s;
+    const double dt_s = stamp_s - last_odometry_stamp_s_;
     const Pose2 step = Between(*last_T_odom_robot_, T_odom_robot);
     const double allowed_m = kMaxStepM + kMaxSpeedMps * dt_s;
-    if (TranslationNorm(step) > allowed_m) {
+    const double allowed_rad = kMaxTurnRad + kMaxTurnRateRadps * dt_s;
+    if (TranslationNorm(step) > allowed_m || std::abs(step.theta) > allowed_rad) {
       // The robot is taken not to have moved across the jump: SLAM's odometry stays continuous
       // (ICP still measures the true motion), map -> odom follows the new odometry frame.
       ++status_.odometry_jumps;
       output.events.push_back(
           {NodeEventLevel::kWarning,
-           "scan at " + StampText(synced.scan.timestamp_s) + ": the odometry moved " +
-               FixedText(TranslationNorm(step), 3) + " m in " + FixedText(dt_s, 3) +
-               " s (more than " + FixedText(allowed_m, 3) +
-               " m): a reset or a glitch of the odometry, not motion; " + "absorbed"});
+           "scan at " + StampText(stamp_s) + ": the odometry moved " +
+               FixedText(TranslationNorm(step), 3) + " m and turned " +
+               FixedText(step.theta * 180.0 / M_PI, 1) + " deg in " + FixedText(dt_s, 3) +
+               " s (more than " + FixedText(allowed_m, 3) + " m or " +
+               FixedText(allowed_rad * 180.0 / M_PI, 1) +
+               " deg): a reset or a glitch of the odometry, not motion; absorbed"});
       T_continuous_odom_ = T_continuous_odom_ * *last_T_odom_robot_ * T_odom_robot.inverse();
     }
   }
   last_T_odom_robot_ = T_odom_robot;
+  last_odometry_stamp_s_ = stamp_s;
   return T_continuous_odom_ * T_odom_robot;
 }
 
@@ -89,10 +94,11 @@ void SlamNode::Process(SyncedScan& synced, SlamNodeOutput& output) {
   const double stamp_s = synced.scan.timestamp_s;
   const Pose2 T_odom_robot = ContinuousOdometry(synced, output);
   const auto start = std::chrono::steady_clock::now();
-  const int step_index = static_cast<int>(status_.scans_processed);
+  // Unique per call, even for a scan OnlineSlam throws on after recording it.
+  const int scan_index = next_scan_index_++;
   SlamStep step;
   try {
-    step = slam_.AddScan(step_index, synced.scan, T_odom_robot);
+    step = slam_.AddScan(scan_index, synced.scan, T_odom_robot);
   } catch (const std::exception& error) {
     ++status_.scans_dropped;
     output.events.push_back(
@@ -104,7 +110,7 @@ void SlamNode::Process(SyncedScan& synced, SlamNodeOutput& output) {
   status_.last_scan_stamp_s = stamp_s;
   if (step.odometry.keyframe || keyframes_.empty()) {
     keyframes_.push_back(std::move(synced.scan));
-    keyframe_steps_.push_back(step_index);
+    keyframe_indices_.push_back(scan_index);
   }
   if (step.submap_completed) {
     status_.submaps = slam_.map().submaps.size();
@@ -158,9 +164,14 @@ OccupancyGrid SlamNode::Grid() const {
   std::vector<Pose2> T_world_robot;
   scans.reserve(keyframes_.size());
   T_world_robot.reserve(keyframes_.size());
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    scans.push_back(&keyframes_[k]);
-    T_world_robot.push_back(trajectory[static_cast<std::size_t>(keyframe_steps_[k])].T_world_robot);
+  // Both in processing order: the keyframes are found by their scan_index in one pass.
+  std::size_t k = 0;
+  for (const OnlineSlam::ScanPose& pose : trajectory) {
+    if (k < keyframes_.size() && pose.scan_index == keyframe_indices_[k]) {
+      scans.push_back(&keyframes_[k]);
+      T_world_robot.push_back(pose.T_world_robot);
+      ++k;
+    }
   }
   return BuildOccupancyGrid(scans, T_world_robot, config_.grid);
 }
@@ -173,7 +184,8 @@ GlobalMap SlamNode::Map() const {
   return map;
 }
 
-SavedSlamMap SlamNode::SaveMap(const std::string& map_path) const {
+SavedSlamMap SlamNode::SaveMap(const std::string& map_path) {
+  slam_.Finish();  // loops not optimised yet (slam.optimize_every_loops > 1)
   const GlobalMap map = Map();
   if (map.submaps.empty()) {
     throw std::invalid_argument("no submap completed yet (" +

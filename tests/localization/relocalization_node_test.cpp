@@ -157,11 +157,14 @@ TEST(RelocalizationNode, MapToOdomGoesOutWithEveryScanWhileFixedAndNoInitialPose
   std::size_t fixed_scans = 0;
   for (const FixStatus status : run.statuses) fixed_scans += status == FixStatus::kFixed;
   ASSERT_GT(fixed_scans, 10U);
-  // Each fixed scan sends one, stamped with it; the periodic one (node.status_period_s, here
-  // 1 s of stamps) comes with odometry when no scan sent one.
+  // Each fixed scan sends one, stamped with it, and no message without a scan (odometry comes at
+  // the next scan's stamp: tf refuses a second transform at a stamp it has).
   std::size_t with_scans = 0;
   for (const NodeOutput& output : run.outputs) {
-    if (output.scans.empty()) continue;
+    if (output.scans.empty()) {
+      EXPECT_TRUE(output.transforms.empty());
+      continue;
+    }
     ASSERT_EQ(output.scans.size(), 1U);
     const bool fixed = output.scans.front().status == FixStatus::kFixed;
     ASSERT_EQ(output.transforms.size(), fixed ? 1U : 0U);
@@ -176,6 +179,16 @@ TEST(RelocalizationNode, MapToOdomGoesOutWithEveryScanWhileFixedAndNoInitialPose
     EXPECT_EQ(transform.child_frame, "odom");
     EXPECT_LT(TranslationNorm(Between(kT_odom_world.inverse(), transform.T_parent_child)), 0.5);
   }
+  // While no scan comes, the wrapper's clock sends the fix's map -> odom every
+  // node.status_period_s (1 s), and not within a period of the last one.
+  const double last_s = node.status().last_scan_stamp_s;
+  EXPECT_TRUE(node.Tick(last_s + 0.5).transforms.empty());
+  const NodeOutput quiet = node.Tick(last_s + 1.0);
+  ASSERT_EQ(quiet.transforms.size(), 1U);
+  EXPECT_EQ(quiet.transforms.front().stamp_s, last_s + 1.0);
+  EXPECT_EQ(quiet.transforms.front().T_parent_child.x, node.status().T_world_odom.x);
+  EXPECT_TRUE(node.Tick(last_s + 1.5).transforms.empty());
+  EXPECT_EQ(node.Tick(last_s + 2.0).transforms.size(), 1U);
 }
 
 TEST(RelocalizationNode, RelocalizeSearchesAgainAndTheNextFixIsPublishedAgain) {

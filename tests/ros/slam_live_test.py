@@ -87,7 +87,8 @@ def run(args, processes, work, bag, truth_log):
     play_wall_s = time.monotonic() - play_started
     time.sleep(1.5)  # the last scans and one more status
     assert maps, "no /map while the bag played:\n" + processes.log_of("node")
-    # The last /map: the clock sends the scans since the previous one within a period.
+    # Every /map the node reports has arrived (under simulated time /clock stops with rosbag
+    # play, so no later one comes from the node's clock).
     wait_for(lambda: statuses and maps and
              int(statuses[-1][1]["maps_published"]) == len(maps), 15, "the last /map")
 

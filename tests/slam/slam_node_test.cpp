@@ -76,7 +76,7 @@ struct SharedRun {
   SlamNodeRun run;
 };
 
-const SharedRun& DefaultRun() {
+SharedRun& DefaultRun() {
   static SharedRun* const shared = [] {
     auto* streamed = new SharedRun;
     streamed->run = Stream(streamed->node, kScans);
@@ -175,7 +175,7 @@ TEST(SlamNode, SaveMapWritesAMapAndAGridThatLoad) {
   EXPECT_FALSE(std::filesystem::exists(directory + "/early.kpm"));
   EXPECT_FALSE(std::filesystem::exists(directory + "/early.yaml"));
 
-  const SlamNode& full = DefaultRun().node;
+  SlamNode& full = DefaultRun().node;
   const SavedSlamMap saved = full.SaveMap(directory + "/site.kpm");
   EXPECT_EQ(saved.grid_path, directory + "/site.yaml");
   EXPECT_EQ(saved.scans, kScans);
@@ -224,27 +224,98 @@ TEST(SlamNode, AnOdometryJumpIsAbsorbedAndTheMapGoesOn) {
 TEST(SlamNode, HostileScansAreDroppedAndMappingGoesOn) {
   const Config config;
   SlamNode node(config);
-  Stream(node, 50);
-  const double stamp_s = BundledFr079().inputs.log.scans[49].timestamp_s;
-  ScanInput empty = testing::BundledScanMessage(50);
-  empty.stamp_s = stamp_s + 0.01;
+  const std::vector<LogScan>& scans = BundledFr079().inputs.log.scans;
+  // Up to the scan that completes a submap: the next one starts a new submap.
+  std::size_t k = 0;
+  for (; k < 200 && node.status().submaps == 0; ++k) {
+    node.AddOdometry({scans[k].timestamp_s, TrueOdometry(k)});
+    node.AddScan(testing::BundledScanMessage(k));
+  }
+  ASSERT_EQ(node.status().submaps, 1U);
+  const double stamp_s = scans[k - 1].timestamp_s;
+  const auto at = [&](double dt_s) {
+    ScanInput scan = testing::BundledScanMessage(k);
+    scan.stamp_s = stamp_s + dt_s;
+    return scan;
+  };
+  ScanInput empty = at(0.01);
   empty.ranges_m.clear();
-  ScanInput huge = testing::BundledScanMessage(50);
-  huge.stamp_s = stamp_s + 0.02;
+  ScanInput huge = at(0.02);
   huge.ranges_m.assign(9000, 1.0F);
-  ScanInput nan = testing::BundledScanMessage(50);
-  nan.stamp_s = stamp_s + 0.03;
+  // A valid beam 5 km away at 45 degrees as the first scan of a submap: the mapper refuses it
+  // (its stability grid would exceed mapping.max_grid_cells), and the map must not break.
+  ScanInput far = at(0.03);
+  far.range_max_m = 1e4;
+  far.ranges_m[far.ranges_m.size() / 4] = 5000.0F;
+  ScanInput nan = at(0.04);
   nan.ranges_m.assign(nan.ranges_m.size(), std::nanf(""));
-  for (const ScanInput& scan : {empty, huge, nan}) EXPECT_NO_THROW(node.AddScan(scan));
-  node.AddOdometry({stamp_s + 0.05, TrueOdometry(49)});
-  EXPECT_EQ(node.status().scans_dropped, 2U);  // the all-NaN scan is a scan without returns
-  EXPECT_NO_THROW(node.AddOdometry({stamp_s + 0.06, TrueOdometry(49)}));
-  EXPECT_GE(node.status().scans_processed, 50U);
+  SlamNodeRun run;
+  for (const ScanInput& scan : {empty, huge, far, nan}) {
+    SlamNodeOutput output;
+    EXPECT_NO_THROW(output = node.AddScan(scan));
+    run.Add(std::move(output));
+  }
+  run.Add(node.AddOdometry({stamp_s + 0.05, TrueOdometry(k - 1)}));
+  std::string warnings;
+  for (const NodeEvent& event : run.events) warnings += event.what + "\n";
+  testing::ExpectContains(warnings, "alone it would grow the stability grid");
+  EXPECT_EQ(node.status().scans_dropped, 3U);       // empty, 9000 beams, the 5 km beam
+  EXPECT_EQ(node.status().scans_processed, k + 1);  // the all-NaN scan is a scan without returns
+  // Mapping goes on: the next 200 scans complete submaps as before.
+  const std::size_t processed = node.status().scans_processed;
+  for (std::size_t next = k; next < k + 200; ++next) {
+    node.AddOdometry({scans[next].timestamp_s, TrueOdometry(next)});
+    node.AddScan(testing::BundledScanMessage(next));
+  }
+  EXPECT_EQ(node.status().scans_dropped, 3U);
+  EXPECT_EQ(node.status().scans_processed, processed + 200);
+  EXPECT_GT(node.status().submaps, 4U);
+  EXPECT_NO_THROW(node.Grid());
+  EXPECT_NO_THROW(node.SaveMap(testing::MakeTempDir("slam_node_hostile") + "/site.kpm"));
+}
+
+TEST(SlamNode, AHeadingResetIsAbsorbedToo) {
+  const Config config;
+  SlamNode node(config);
+  const std::vector<LogScan>& scans = BundledFr079().inputs.log.scans;
+  constexpr std::size_t kResetAt = 100;
+  // The odometry frame turns by 3 rad about the robot (an IMU's yaw reset) while it stands: the
+  // scan before the reset is sent again 0.1 s later with the reset odometry, a heading jump of
+  // more than 0.5 rad + one turn per second. (The bundled log's scans are 0.42 s apart at least,
+  // over which one turn per second allows any heading change.)
+  const Pose2 at_robot(TrueOdometry(kResetAt - 1).x, TrueOdometry(kResetAt - 1).y, 0.0);
+  const Pose2 reset = at_robot * Pose2(0.0, 0.0, 3.0) * at_robot.inverse();
+  std::vector<Pose2> T_map_robot;  // of the log's scans
+  const auto send = [&](std::size_t k, double stamp_s, const Pose2& T_odom_robot) {
+    node.AddOdometry({stamp_s, T_odom_robot});
+    ScanInput scan = testing::BundledScanMessage(k);
+    scan.stamp_s = stamp_s;
+    const SlamNodeOutput output = node.AddScan(scan);
+    EXPECT_FALSE(output.transforms.empty()) << "scan " << k;
+    return output.transforms.empty() ? Pose2()
+                                     : output.transforms.front().T_parent_child * T_odom_robot;
+  };
+  for (std::size_t k = 0; k < 150; ++k) {
+    if (k == kResetAt) send(k - 1, scans[k - 1].timestamp_s + 0.1, reset * TrueOdometry(k - 1));
+    const Pose2 T_odom_robot = k >= kResetAt ? reset * TrueOdometry(k) : TrueOdometry(k);
+    T_map_robot.push_back(send(k, scans[k].timestamp_s, T_odom_robot));
+  }
+  EXPECT_EQ(node.status().odometry_jumps, 1U);
+  // The map poses are those of the run without the reset.
+  const SlamNodeRun& smooth = DefaultRun().run;
+  for (std::size_t i = 0; i < T_map_robot.size(); ++i) {
+    const Pose2 difference = Between(smooth.T_map_odom[i] * smooth.T_odom_robot[i], T_map_robot[i]);
+    ASSERT_LT(TranslationNorm(difference), 0.3) << "scan " << i;
+    ASSERT_LT(std::abs(difference.theta), 5.0 * M_PI / 180.0) << "scan " << i;
+  }
 }
 
 TEST(SlamNode, RefusesAnInvalidNodeSection) {
   Config config;
   config.node.map_period_s = 0.0;
+  EXPECT_THROW(SlamNode node(config), std::invalid_argument);
+  config.node.map_period_s = 5.0;
+  config.node.map_path = "site.yaml";  // the grid's own name
   EXPECT_THROW(SlamNode node(config), std::invalid_argument);
   EXPECT_EQ(GridPathOf("maps/site.kpm"), "maps/site.yaml");
   EXPECT_EQ(GridPathOf("maps.d/site"), "maps.d/site.yaml");

@@ -46,8 +46,6 @@ class SensorSync {
   SyncOutput AddOdometry(const OdometryInput& odometry);
   /// The next scan: released as soon as odometry covers its stamp.
   SyncOutput AddScan(const ScanInput& scan);
-  /// Forgets the waiting scans and the odometry (after an odometry reset, for example).
-  void Clear();
 
   std::size_t scans_received() const { return scans_received_; }
   std::size_t scans_dropped() const { return scans_dropped_; }

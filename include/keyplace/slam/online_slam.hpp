@@ -155,7 +155,10 @@ class OnlineSlam {
 
   /// Adds the next scan (processing order) with the robot's odometry pose when there is one and
   /// its FLIRT keypoints (laser frame). `scan_index` is the caller's index of the scan (e.g. its
-  /// file index), kept in the submaps and poses.
+  /// file index), kept in the submaps and poses. A scan the local mapper refuses (a non-finite
+  /// pose, a beam that would grow its grid beyond mapping.max_grid_cells) throws
+  /// std::invalid_argument and leaves the map and the submap in progress as they were (the ICP
+  /// odometry keeps the scan).
   SlamStep AddScan(int scan_index, const LaserScan& scan, const std::optional<Pose2>& T_odom_robot,
                    const std::vector<Keypoint>& keypoints);
 

@@ -12,6 +12,7 @@
 //   on a timer:   Publish(node.Tick(now_s));
 //   ~save_map:    node.SaveMap(config.node.map_path);
 
+#include <cmath>
 #include <cstddef>
 #include <deque>
 #include <optional>
@@ -78,11 +79,15 @@ struct SavedSlamMap {
 class SlamNode {
  public:
   static constexpr std::size_t kLatencyWindow = 10000;
-  // A step of the odometry between two scans longer than kMaxStepM + kMaxSpeedMps * dt is a
-  // reset or a glitch of the odometry frame, not motion: no ground robot keyplace maps with
-  // moves 10 m/s indoors, and 1 m covers a scan that waits long for its odometry.
+  // A step of the odometry between two scans longer than kMaxStepM + kMaxSpeedMps * dt, or a turn
+  // larger than kMaxTurnRad + kMaxTurnRateRadps * dt, is a reset or a glitch of the odometry
+  // frame, not motion: no ground robot keyplace maps with moves 10 m/s indoors or spins a turn a
+  // second (a TurtleBot's limit is 2.84 rad/s), and the constant terms cover a scan that waits
+  // long for its odometry.
   static constexpr double kMaxSpeedMps = 10.0;
   static constexpr double kMaxStepM = 1.0;
+  static constexpr double kMaxTurnRateRadps = 2.0 * M_PI;
+  static constexpr double kMaxTurnRad = 0.5;
 
   /// SLAM with `config` (odometry, mapping, place, slam, features; input says where the laser
   /// sits, node what is published and grid how /map is drawn). Throws std::invalid_argument
@@ -101,10 +106,10 @@ class SlamNode {
   OccupancyGrid Grid() const;
   /// The map so far (loops optimised), with the configuration that made it.
   GlobalMap Map() const;
-  /// Writes Map() to `map_path` (.kpm) and Grid() as a map_server map beside it (.yaml, .pgm),
-  /// each atomically. Throws std::invalid_argument before the first submap completes,
-  /// std::runtime_error naming a file that cannot be written.
-  SavedSlamMap SaveMap(const std::string& map_path) const;
+  /// Optimises the loops not optimised yet, then writes Map() to `map_path` (.kpm) and Grid() as a
+  /// map_server map beside it (.yaml, .pgm), each atomically. Throws std::invalid_argument before
+  /// the first submap completes, std::runtime_error naming a file that cannot be written.
+  SavedSlamMap SaveMap(const std::string& map_path);
 
   SlamNodeStatus status() const;
   const Config& config() const { return config_; }
@@ -123,9 +128,11 @@ class SlamNode {
   OnlineSlam slam_;
   SensorSync sync_;
   SlamNodeStatus status_;
-  std::vector<LaserScan> keyframes_;        // the scans the grid is drawn from
-  std::vector<int> keyframe_steps_;         // their processing index in OnlineSlam
-  std::optional<Pose2> last_T_odom_robot_;  // as received, at the last processed scan
+  std::vector<LaserScan> keyframes_;   // the scans the grid is drawn from
+  std::vector<int> keyframe_indices_;  // their scan_index in OnlineSlam
+  int next_scan_index_ = 0;
+  std::optional<Pose2> last_T_odom_robot_;  // as received, at the last scan given to SLAM
+  double last_odometry_stamp_s_ = 0.0;      // that scan's stamp
   Pose2 T_continuous_odom_;                 // absorbs the odometry jumps
   std::optional<double> last_status_s_;     // when the status was last due
   std::optional<double> last_map_s_;        // when /map last went out
