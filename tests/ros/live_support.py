@@ -2,6 +2,7 @@
 environment, a roscore on it with simulated time, processes started in their own sessions and
 killed by id, bounded waits, and the corrected poses of the FR079 log as truth."""
 
+import argparse
 import gzip
 import os
 import signal
@@ -76,6 +77,31 @@ def wait_for(condition, timeout_s, what):
             return
         time.sleep(0.05)
     raise AssertionError("timed out after %.0f s waiting for %s" % (timeout_s, what))
+
+
+# The bag's converter wrote the laser at x = +0.04 m and beams pi/359 apart; the log has -0.04 m
+# and pi/360 (docs/ROS.md, "Checked against a real bag").
+BAG_FIXES = "input.laser_pose=-0.04,0,0 input.scan_fov_rad=3.141592653589793"
+
+
+def live_arguments(default_rate):
+    """The live tests' command line (KEYPLACE_CLI NODE_BINARY SOURCE_DIR [--rate R]
+    [--duration S]) and the shared data they play: (args, fr079.orig.bag, fr079-corrected.log.gz).
+    Exits naming a file that is missing."""
+    parser = argparse.ArgumentParser()
+    parser.add_argument("keyplace")
+    parser.add_argument("node")
+    parser.add_argument("source_dir")
+    parser.add_argument("--rate", type=float, default=default_rate)
+    parser.add_argument("--duration", type=float, default=150.0, help="bag seconds played")
+    args = parser.parse_args()
+    shared = os.environ.get("KEYPLACE_SHARED", os.path.join(args.source_dir, "..", "shared"))
+    bag = os.path.join(shared, "data", "fr079.orig.bag")
+    truth_log = os.path.join(shared, "data", "fr079-corrected.log.gz")
+    for path in (bag, truth_log):
+        if not os.path.exists(path):
+            raise SystemExit("missing " + path)
+    return args, bag, truth_log
 
 
 def ros_environment(work):

@@ -13,7 +13,6 @@ process is started here, in its own session, and killed here by its id; every wa
 Usage: slam_live_test.py KEYPLACE_CLI NODE_BINARY SOURCE_DIR [--rate R] [--duration S]
 """
 
-import argparse
 import math
 import os
 import subprocess
@@ -22,30 +21,16 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from live_support import (Processes, collect_statuses, corrected_poses,  # noqa: E402
-                          ros_environment, start_roscore, wait_for, wait_for_service)
+from live_support import (BAG_FIXES, Processes, collect_statuses,  # noqa: E402
+                          corrected_poses, live_arguments, ros_environment, start_roscore,
+                          wait_for, wait_for_service)
 
-# The bag's converter wrote the laser at x = +0.04 m and beams pi/359 apart; the log has -0.04 m
-# and pi/360 (docs/ROS.md, "Checked against a real bag").
-BAG_FIXES = "input.laser_pose=-0.04,0,0 input.scan_fov_rad=3.141592653589793"
 TOLERANCE_M = 1.0
 SCAN_RATE_HZ = 4934 / 1061.7  # fr079.orig.bag: 4934 scans over 1061.7 s
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("keyplace")
-    parser.add_argument("node")
-    parser.add_argument("source_dir")
-    parser.add_argument("--rate", type=float, default=5.0)
-    parser.add_argument("--duration", type=float, default=150.0, help="bag seconds played")
-    args = parser.parse_args()
-    shared = os.environ.get("KEYPLACE_SHARED", os.path.join(args.source_dir, "..", "shared"))
-    bag = os.path.join(shared, "data", "fr079.orig.bag")
-    truth_log = os.path.join(shared, "data", "fr079-corrected.log.gz")
-    for path in (bag, truth_log):
-        if not os.path.exists(path):
-            raise SystemExit("missing " + path)
+    args, bag, truth_log = live_arguments(5.0)
     work = tempfile.mkdtemp(prefix="keyplace_ros_slam_")
     env = ros_environment(work)
     processes = Processes(env, work)
