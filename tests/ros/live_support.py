@@ -159,3 +159,27 @@ def wait_for_service(service, node, processes):
 
     wait_for(node_up, 30, "the node's services")
     assert node.poll() is None, processes.log_of("node")
+
+
+SCAN_RATE_HZ = 4934 / 1061.7  # fr079.orig.bag: 4934 scans over 1061.7 s
+
+
+def check_scans_and_latency(last, args, play_wall_s):
+    """Prints the node's per-scan latency and the real-time factors from its last status, and
+    checks that it received the played scans and processed every one: rosbag play starts /scan
+    and /odom at the same instant, so the first scan may precede the first odometry message
+    (dropped, as it has no pose), and rosbag play may stop after a scan whose odometry it never
+    plays (left waiting)."""
+    received, processed = int(last["scans_received"]), int(last["scans_processed"])
+    dropped, waiting = int(last["scans_dropped"]), int(last["scans_waiting"])
+    mean_s, p99_s = float(last["latency_mean_s"]), float(last["latency_p99_s"])
+    print("per-scan latency: mean %.1f ms, p99 %.1f ms, max %.1f ms" % (
+        1e3 * mean_s, 1e3 * p99_s, 1e3 * float(last["latency_max_s"])))
+    print("bag played at %.1fx: %.0f bag s in %.1f wall s (%.1fx real time); the node's mean "
+          "latency allows %.1fx, its p99 %.1fx" % (
+              args.rate, args.duration, play_wall_s, args.duration / play_wall_s,
+              1.0 / (SCAN_RATE_HZ * mean_s), 1.0 / (SCAN_RATE_HZ * p99_s)))
+    expected = SCAN_RATE_HZ * args.duration
+    assert received > 0.9 * expected, (received, expected)
+    assert dropped <= 1 and waiting <= 1, "the node dropped scans"
+    assert processed + dropped + waiting == received, (processed, dropped, waiting, received)
