@@ -53,6 +53,9 @@ void Validate(const FixPolicy& policy) {
   require_positive(policy.agree_deg, "agree_deg");
   require_positive(policy.window_m, "window_m");
   require_positive(policy.lost_after_m, "lost_after_m");
+  if (!(policy.track_check_every_m >= 0.0) || !std::isfinite(policy.track_check_every_m)) {
+    throw std::invalid_argument("FixPolicy.track_check_every_m must be finite and >= 0");
+  }
   for (const auto& [value, name] :
        {std::pair<double, const char*>{policy.map_sigma_m, "map_sigma_m"},
         {policy.map_sigma_deg, "map_sigma_deg"}}) {

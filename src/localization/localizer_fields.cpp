@@ -23,6 +23,9 @@ const ConfigFields<FixPolicy>& FixPolicyFields() {
                 "a fix no answer confirmed over this odometry distance is lost")
         .Double("contradiction_confidence", &C::contradiction_confidence, "",
                 "one accepted answer this confident contradicting the fix loses it at once")
+        .Double("track_check_every_m", &C::track_check_every_m, "m",
+                "while fixed, check every this much odometry that the latest scans fit the map "
+                "at the fix; a misfit loses it (0 = off)")
         .Double("map_sigma_m", &C::map_sigma_m, "m",
                 "the map's own position error, added to a fix's covariance from the matches")
         .Double("map_sigma_deg", &C::map_sigma_deg, "deg",

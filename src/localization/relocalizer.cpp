@@ -32,21 +32,57 @@ std::string ToString(FixStatus status) {
 
 Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
                          const FlirtConfig& features)
-    : localizer_(map, config, features), filter_(config.fix) {}
+    : localizer_(map, config, features), filter_(config.fix), track_(config.fix.agree_deg) {}
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
-  return filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
+  track_.AddScan(scan, T_odom_robot, -1);
+  RelocalizationUpdate update =
+      filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
+  CheckTrack(T_odom_robot, update);
+  return update;
 }
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
-  return filter_.Update(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id),
-                        T_odom_robot);
+  track_.AddScan(scan, T_odom_robot, scan_id);
+  RelocalizationUpdate update = filter_.Update(
+      localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id), T_odom_robot);
+  CheckTrack(T_odom_robot, update);
+  return update;
 }
 
 void Relocalizer::Reset() {
   localizer_.Reset();
   filter_.Reset();
+  track_.Reset();
+  last_T_odom_robot_.reset();
+  since_check_m_ = 0.0;
+}
+
+// A new fix passed the dense check of its answers: the first check comes a check distance later.
+// An answer confirming the fix does not spare it the check: answers come from query submaps that
+// may straddle an odometry error.
+void Relocalizer::CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& update) {
+  const FixPolicy& policy = localizer_.config().fix;
+  if (last_T_odom_robot_) {
+    since_check_m_ += TranslationNorm(Between(*last_T_odom_robot_, T_odom_robot));
+  }
+  last_T_odom_robot_ = T_odom_robot;
+  if (update.status != FixStatus::kFixed || update.new_fix) {
+    since_check_m_ = 0.0;
+    return;
+  }
+  if (policy.track_check_every_m <= 0.0 || since_check_m_ < policy.track_check_every_m) return;
+  since_check_m_ = 0.0;
+  const TrackCheckResult check = track_.Check(localizer_.recognizer(), localizer_.config().place,
+                                              update.T_world_odom, exclusion_);
+  update.track_fit = check.fit;
+  if (check.fit != TrackFit::kMisfit) return;
+  // The odometry, not the map, went wrong: the query being built spans the error too, and its
+  // answers would put the robot where the error did.
+  localizer_.Reset();
+  filter_.GiveUp(update);
+  update.track_misfit = true;
 }
 
 FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(policy_); }
@@ -270,6 +306,19 @@ void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypoth
   hypotheses_.clear();
   challengers_.clear();
   update.new_fix = true;
+}
+
+void FixFilter::GiveUp(RelocalizationUpdate& update) {
+  if (status_ != FixStatus::kFixed) return;
+  DeclareLost(update);
+  update.status = status_;
+  update.T_world_robot = Pose2();
+  update.T_world_odom = Pose2();
+  update.confidence = 0.0;
+  update.unconfirmed_m = 0.0;
+  update.position_variance_m2 = 0.0;
+  update.heading_variance_rad2 = 0.0;
+  update.covariance.setZero();
 }
 
 void FixFilter::DeclareLost(RelocalizationUpdate& update) {

@@ -47,6 +47,11 @@ struct FixPolicy {
   // One accepted answer at least this confident that contradicts the fix gives it up at once;
   // less confident ones must agree with each other (confirmations of them) first.
   double contradiction_confidence = 0.9;
+  // Every this much odometry while fixed, the latest scans are put into the map by the fix and
+  // scored against the occupancy of the places around the robot (TrackCheck, with place
+  // recognition's dense thresholds); a check that finds them off the walls where a pose nearby
+  // puts them on the walls gives the fix up (lost). 0 = off.
+  double track_check_every_m = 1.0;
   // The map's own error, which no match removes: added to the covariance derived from the matches
   // (RelocalizationUpdate::covariance) as independent per-axis sigmas. Chosen on FR079 (the
   // first fixes' errors against the corrected poses: median 0.03 m and 0.3 deg, while the

@@ -28,6 +28,7 @@
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/localization/track_check.hpp"
 #include "keyplace/mapping/global_map.hpp"
 
 namespace keyplace {
@@ -73,6 +74,11 @@ struct RelocalizationUpdate {
   // The answer came from a query whose accepted answers disagree with each other (it sees a
   // place that looks like another); it and the query's other answers were set aside.
   bool self_contradicted = false;
+  // The track was checked against the map with this scan (FixPolicy::track_check_every_m):
+  // kUnknown when it was not, or when the map has too little around the robot to tell.
+  TrackFit track_fit = TrackFit::kUnknown;
+  // The fix was given up (lost) because the track check found the scans off the map.
+  bool track_misfit = false;
 };
 
 /// The temporal part alone: turns a stream of answers (one per scan, most of them none) into
@@ -88,6 +94,10 @@ class FixFilter {
 
   void Reset();
   FixStatus status() const { return status_; }
+
+  /// Gives the fix up, as an answer contradicting it would (update: the one of this scan, which
+  /// becomes kLost without a pose). No effect without a fix.
+  void GiveUp(RelocalizationUpdate& update);
 
  private:
   // An accepted answer, kept as a hypothesis of T_world_odom.
@@ -159,13 +169,23 @@ class Relocalizer {
   /// Forgets everything: fix, hypotheses and the query being built (the robot was kidnapped).
   void Reset();
 
-  void set_exclusion(QueryExclusion exclusion) { localizer_.set_exclusion(std::move(exclusion)); }
+  void set_exclusion(QueryExclusion exclusion) {
+    exclusion_ = exclusion;
+    localizer_.set_exclusion(std::move(exclusion));
+  }
   FixStatus status() const { return filter_.status(); }
   const GlobalLocalizer& localizer() const { return localizer_; }
 
  private:
+  // The track check of FixPolicy::track_check_every_m, on `update` of the scan just added.
+  void CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& update);
+
   GlobalLocalizer localizer_;
   FixFilter filter_;
+  TrackCheck track_;
+  QueryExclusion exclusion_;
+  std::optional<Pose2> last_T_odom_robot_;
+  double since_check_m_ = 0.0;  // odometry since the fix or its last check
 };
 
 }  // namespace keyplace
