@@ -166,7 +166,13 @@ void BindRelocalizer(py::module_& module) {
       .def_readonly("confirmed", &RelocalizationUpdate::confirmed)
       .def_readonly("contradicted", &RelocalizationUpdate::contradicted)
       .def_readonly("self_contradicted", &RelocalizationUpdate::self_contradicted,
-                    "The answer's query named places that disagree: its answers were set aside.");
+                    "The answer's query named places that disagree: its answers were set aside.")
+      .def_property_readonly(
+          "track_fit", [](const RelocalizationUpdate& u) { return ToString(u.track_fit); },
+          "The track check of this scan: 'unknown' (none, or the map cannot tell), 'fits' or "
+          "'misfit'.")
+      .def_readonly("track_misfit", &RelocalizationUpdate::track_misfit,
+                    "The fix was given up because the scans no longer fit the map at it.");
 
   py::class_<Relocalizer>(module, "Relocalizer",
                           "The GlobalLocalizer's answers turned into a fix once they agree "

@@ -124,7 +124,10 @@ void RelocalizationNode::Publish(const RelocalizationUpdate& update, double stam
   }
   if (update.lost) {
     ++status_.losses;
-    output.events.push_back({NodeEventLevel::kWarning, at + ": fix lost"});
+    output.events.push_back({NodeEventLevel::kWarning,
+                             at + (update.track_misfit ? ": fix lost (the scans no longer fit the "
+                                                         "map there: odometry error?)"
+                                                       : ": fix lost")});
   }
   if (update.status != FixStatus::kFixed) {
     status_.pose.reset();

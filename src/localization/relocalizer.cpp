@@ -319,6 +319,7 @@ void FixFilter::GiveUp(RelocalizationUpdate& update) {
   update.position_variance_m2 = 0.0;
   update.heading_variance_rad2 = 0.0;
   update.covariance.setZero();
+  update.confirmed = false;  // an answer of this scan may have confirmed what is now given up
 }
 
 void FixFilter::DeclareLost(RelocalizationUpdate& update) {

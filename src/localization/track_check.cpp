@@ -2,30 +2,34 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 namespace keyplace {
 namespace {
 
-// The reference is made of the map places whose frames lie nearest the robot: as many as place
-// recognition scores a candidate with (the candidate and a neighbour on each side), within the
-// path of one bounded submap (mapping.max_path_m) of the robot.
+// The reference is made of the map places whose frames lie nearest the robot, within the path of
+// one bounded submap (mapping.max_path_m): 8 of them, because the 3 that place recognition scores
+// a candidate with (the candidate and a neighbour on each side) missed rooms the robot's scans
+// looked into and gave up Intel's correct tracks (docs/LOCALIZATION.md).
 constexpr std::size_t kTrackPlaces = 8;
 constexpr double kTrackPlaceRadiusM = 8.0;
 // Fewest endpoints where the reference looked for a verdict (as for a candidate's dense score).
 constexpr int kTrackMinEndpoints = 50;
-// The poses searched around a fix that fails the veto: turns up to the largest heading errors
-// odometry has left in the logs (41 degrees after a fast turn, issue 30) and the translation of
-// a few scans, on steps finer than the hit distance at 5 m; every 4th endpoint (about 225).
-constexpr double kSearchHalfTurnRad = 45.0 * M_PI / 180.0;
-constexpr double kSearchTurnStepRad = 2.0 * M_PI / 180.0;
-constexpr double kSearchHalfShiftM = 0.8;
+// The poses searched around a fix that does not fit beyond doubt: turns up to the largest heading
+// errors odometry has left in the logs (41 degrees after a fast turn, issue 30) and the shift of
+// the window below, on steps about the hit distance at 5 m; every 2nd endpoint (about 135).
+constexpr int kSearchTurnSteps = 18;  // each side
+constexpr double kSearchTurnStepRad = 2.5 * M_PI / 180.0;
+constexpr int kSearchShiftSteps = 4;  // each side
 constexpr double kSearchShiftStepM = 0.2;
 constexpr std::size_t kSearchStride = 2;
 // The search uses the latest scans only: an odometry error that came between the recent scans
 // (a turn it missed) leaves no single correction for all of them, and one made about the robot's
 // position now is a turn plus a shift that grows with the path since the error (0.6 m per metre
-// at 35 degrees, 0.77 m at 45): with a check every metre, the latest scans need the window above.
+// at 35 degrees, 0.77 m at 45): with a check every metre (the default track_check_every_m), the
+// latest scans need the window above. A pose that puts most of them outside the places' area
+// says nothing: it must keep half of the endpoints the fix has there.
 constexpr std::size_t kSearchScans = 3;
 
 // Indices of up to kTrackPlaces places with occupancy nearest `position_m`, allowed by `allowed`.
@@ -66,24 +70,23 @@ std::vector<Eigen::Vector2i> WorldCells(const std::vector<Place>& places,
 }
 
 // The best hit fraction of `scans` (world frame, as the fix put them) over the poses of the search
-// window: turned about the robot's position `robot_m`, then shifted. The fix's own pose is in it.
+// window that keep at least `min_endpoints` of them in the reference's area: turned about the
+// robot's position `robot_m`, then shifted. The fix's own pose is in it.
 std::pair<double, Pose2> BestNearby(const DenseReference& reference,
                                     const std::vector<QueryScanPoints>& scans,
-                                    const Eigen::Vector2d& robot_m) {
-  const int turns = static_cast<int>(std::round(kSearchHalfTurnRad / kSearchTurnStepRad));
-  const int shifts = static_cast<int>(std::round(kSearchHalfShiftM / kSearchShiftStepM));
-  double best = -1.0;
+                                    const Eigen::Vector2d& robot_m, int min_endpoints) {
+  double best = 0.0;
   Pose2 best_correction;  // world frame: applied to the fix's world poses
-  for (int t = -turns; t <= turns; ++t) {
+  for (int t = -kSearchTurnSteps; t <= kSearchTurnSteps; ++t) {
     const Pose2 turn_about_robot = Pose2(robot_m.x(), robot_m.y(), t * kSearchTurnStepRad) *
                                    Pose2(-robot_m.x(), -robot_m.y(), 0.0);
-    for (int i = -shifts; i <= shifts; ++i) {
-      for (int j = -shifts; j <= shifts; ++j) {
+    for (int i = -kSearchShiftSteps; i <= kSearchShiftSteps; ++i) {
+      for (int j = -kSearchShiftSteps; j <= kSearchShiftSteps; ++j) {
         const Pose2 correction =
             Pose2(i * kSearchShiftStepM, j * kSearchShiftStepM, 0.0) * turn_about_robot;
-        const double hit = reference.HitFraction(correction, scans, kSearchStride);
-        if (hit > best) {
-          best = hit;
+        const DenseScore hits = reference.Hits(correction, scans, kSearchStride);
+        if (hits.endpoints >= min_endpoints && hits.hit_fraction > best) {
+          best = hits.hit_fraction;
           best_correction = correction;
         }
       }
@@ -92,7 +95,25 @@ std::pair<double, Pose2> BestNearby(const DenseReference& reference,
   return {best, best_correction};
 }
 
+// The last kSearchScans of `scans`.
+std::vector<QueryScanPoints> Latest(const std::vector<QueryScanPoints>& scans) {
+  const auto count = static_cast<std::ptrdiff_t>(std::min(kSearchScans, scans.size()));
+  return {scans.end() - count, scans.end()};
+}
+
 }  // namespace
+
+std::string ToString(TrackFit fit) {
+  switch (fit) {
+    case TrackFit::kUnknown:
+      return "unknown";
+    case TrackFit::kFits:
+      return "fits";
+    case TrackFit::kMisfit:
+      return "misfit";
+  }
+  return "?";
+}
 
 TrackCheck::TrackCheck(double misfit_turn_deg) : misfit_turn_rad_(misfit_turn_deg * M_PI / 180.0) {}
 
@@ -103,7 +124,7 @@ void TrackCheck::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int s
 
 TrackCheckResult TrackCheck::Check(const PlaceRecognizer& recognizer,
                                    const PlaceRecognitionConfig& place, const Pose2& T_world_odom,
-                                   const QueryExclusion& exclusion) const {
+                                   const QueryExclusion& exclusion) {
   TrackCheckResult result;
   if (scans_.empty()) return result;
   std::vector<int> scan_ids;
@@ -124,32 +145,62 @@ TrackCheckResult TrackCheck::Check(const PlaceRecognizer& recognizer,
   }
   result.places = static_cast<int>(chosen.size());
   result.score = reference.Score(Pose2(), in_world);
+  result.T_world_odom_best = T_world_odom;
   if (result.score.endpoints < kTrackMinEndpoints) return result;
-  if (result.score.hit_fraction >= place.dense_sure_hit_fraction) {
+  Judge(reference, Latest(in_world), robot_m, place, T_world_odom, result);
+  return result;
+}
+
+// The verdict on a fix whose recent scans (score) fell where the places looked. Beyond doubt, on
+// all of them and on the latest, it fits. Otherwise either the fix is off (the older scans may
+// still fit, from before an odometry error, while the latest already miss), or the places did not
+// see all the robot sees now (a room their scans never looked into). Only the first leaves a pose
+// nearby that puts the latest scans on the walls beyond doubt, and by more than the span between
+// the veto and that bar (dense_sure_hit_fraction - dense_min_hit_fraction) better than the fix: a
+// corridor's walls still catch half of the beams turned by 35 degrees. Three scans close together
+// can still prefer a look-alike pose (FR079: turned by 17.5 degrees and shifted by 0.9 m), so
+// such a pose is only a suspect until the next check's scans, which it did not choose, confirm it
+// as a map <- odometry transform: an odometry error is one transform for every scan after it.
+void TrackCheck::Judge(const DenseReference& reference, const std::vector<QueryScanPoints>& latest,
+                       const Eigen::Vector2d& robot_m, const PlaceRecognitionConfig& place,
+                       const Pose2& T_world_odom, TrackCheckResult& result) {
+  const DenseScore at_fix = reference.Hits(Pose2(), latest, kSearchStride);
+  result.latest_hit_fraction = at_fix.hit_fraction;
+  const std::optional<Pose2> suspect = std::exchange(suspect_T_world_odom_, std::nullopt);
+  if (result.score.hit_fraction >= place.dense_sure_hit_fraction &&
+      at_fix.hit_fraction >= place.dense_sure_hit_fraction) {
     result.fit = TrackFit::kFits;
-    return result;
+    return;
   }
-  // Not beyond doubt: either the fix is off (while the older scans still fit, from before an
-  // odometry error, the latest ones already miss), or the places around it did not see all the
-  // robot sees now (a room their scans never looked into). Only the first leaves a pose nearby
-  // that puts the latest scans on the walls beyond doubt, and by more than the span between the
-  // veto and that bar (dense_sure_hit_fraction - dense_min_hit_fraction) better than the fix: a
-  // corridor's walls still catch half of the beams turned by 35 degrees.
-  const std::vector<QueryScanPoints> latest(
-      in_world.end() - static_cast<std::ptrdiff_t>(std::min(kSearchScans, in_world.size())),
-      in_world.end());
-  result.latest_hit_fraction = reference.HitFraction(Pose2(), latest, kSearchStride);
-  const auto [best_hit, correction] = BestNearby(reference, latest, robot_m);
-  result.best_hit_fraction = best_hit;
-  result.T_world_odom_best = correction * T_world_odom;
+  const int min_endpoints = std::max(kTrackMinEndpoints / 2, at_fix.endpoints / 2);
   const double margin = place.dense_sure_hit_fraction - place.dense_min_hit_fraction;
-  if (best_hit >= place.dense_sure_hit_fraction && result.latest_hit_fraction < best_hit - margin &&
-      std::abs(WrapAngle(correction.theta)) > misfit_turn_rad_) {
-    result.fit = TrackFit::kMisfit;
+  const auto much_better = [&](const DenseScore& hits) {
+    return hits.endpoints >= min_endpoints && hits.hit_fraction >= place.dense_sure_hit_fraction &&
+           at_fix.hit_fraction < hits.hit_fraction - margin;
+  };
+  if (suspect) {
+    const DenseScore at_suspect =
+        reference.Hits(*suspect * T_world_odom.inverse(), latest, kSearchStride);
+    result.best_hit_fraction = at_suspect.hit_fraction;
+    if (much_better(at_suspect)) {
+      result.fit = TrackFit::kMisfit;
+      result.T_world_odom_best = *suspect;
+      return;
+    }
+  }
+  const auto [best_hit, correction] = BestNearby(reference, latest, robot_m, min_endpoints);
+  if (best_hit > result.best_hit_fraction) {
+    result.best_hit_fraction = best_hit;
+    result.T_world_odom_best = correction * T_world_odom;
+  }
+  DenseScore best;  // BestNearby only weighs poses with min_endpoints
+  best.endpoints = min_endpoints;
+  best.hit_fraction = best_hit;
+  if (much_better(best) && std::abs(WrapAngle(correction.theta)) > misfit_turn_rad_) {
+    suspect_T_world_odom_ = correction * T_world_odom;
   } else if (result.score.hit_fraction >= place.dense_min_hit_fraction) {
     result.fit = TrackFit::kFits;
   }
-  return result;
 }
 
 }  // namespace keyplace

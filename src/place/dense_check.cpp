@@ -165,23 +165,23 @@ DenseScore DenseReference::Score(const Pose2& T_ref_query,
   return score;
 }
 
-double DenseReference::HitFraction(const Pose2& T_ref_query,
-                                   const std::vector<QueryScanPoints>& scans,
-                                   std::size_t stride) const {
-  if (empty()) return 0.0;
+DenseScore DenseReference::Hits(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
+                                std::size_t stride) const {
+  DenseScore score;
+  if (empty()) return score;
   stride = std::max<std::size_t>(stride, 1);
   const PointMapper to_ref(T_ref_query);
-  int inside = 0;
   int hits = 0;
   for (const QueryScanPoints& scan : scans) {
     for (std::size_t k = 0; k < scan.endpoints_m.size(); k += stride) {
       const Eigen::Vector2d endpoint = to_ref(scan.endpoints_m[k]);
       if (!Inside(endpoint)) continue;
-      ++inside;
+      ++score.endpoints;
       if (FlagsAt(endpoint) & kNearOccupied) ++hits;
     }
   }
-  return inside > 0 ? static_cast<double>(hits) / inside : 0.0;
+  if (score.endpoints > 0) score.hit_fraction = static_cast<double>(hits) / score.endpoints;
+  return score;
 }
 
 }  // namespace keyplace

@@ -50,7 +50,8 @@ struct FixPolicy {
   // Every this much odometry while fixed, the latest scans are put into the map by the fix and
   // scored against the occupancy of the places around the robot (TrackCheck, with place
   // recognition's dense thresholds); a check that finds them off the walls where a pose nearby
-  // puts them on the walls gives the fix up (lost). 0 = off.
+  // puts them on the walls gives the fix up (lost). 0 = off. The search around the fix covers the
+  // shift a missed 45 degree turn makes over about a metre: checks further apart catch less.
   double track_check_every_m = 1.0;
   // The map's own error, which no match removes: added to the covariance derived from the matches
   // (RelocalizationUpdate::covariance) as independent per-axis sigmas. Chosen on FR079 (the

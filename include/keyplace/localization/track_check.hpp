@@ -8,6 +8,8 @@
 // (place/dense_check.hpp, docs/PLACE.md) applied to the track, with its thresholds.
 
 #include <deque>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "keyplace/common/pose2.hpp"
@@ -24,16 +26,18 @@ enum class TrackFit {
   // they miss its walls but so they do at every pose nearby (the map did not see this).
   kUnknown,
   kFits,    // the beams end on the map's walls (place recognition's dense veto passes)
-  kMisfit,  // the latest miss them, and a pose turned from the fix puts them on the walls
+  kMisfit,  // a fix turned from this one, found by the last check, fits the latest scans far better
 };
+
+std::string ToString(TrackFit fit);  // "unknown", "fits", "misfit"
 
 struct TrackCheckResult {
   TrackFit fit = TrackFit::kUnknown;
   DenseScore score;  // at the fix
   int places = 0;    // map places whose occupancy made the reference
-  // When the fix did not fit beyond doubt: the hit fraction of the latest scans at the fix, the
-  // best over the poses searched around it (the robot turned by up to 45 degrees, shifted by up
-  // to 0.8 m) and the fix that gives it.
+  // The hit fraction of the latest 3 scans at the fix (every 2nd endpoint); when the fix did not
+  // fit beyond doubt, the best over the poses searched around it (the robot turned by up to 45
+  // degrees, shifted by up to 0.8 m) and the fix that gives it.
   double latest_hit_fraction = 0.0;
   double best_hit_fraction = 0.0;
   Pose2 T_world_odom_best;
@@ -54,14 +58,19 @@ class TrackCheck {
 
   /// The recent scans put into the map by T_world_odom, scored against the occupancy of the map
   /// places nearest the robot (those `exclusion` allows for the recent scans' ids), judged by
-  /// `place`'s dense thresholds: the fix fits when their hit fraction confirms it beyond doubt
-  /// (dense_sure_hit_fraction) or the latest scans' passes the veto (dense_min_hit_fraction); it
-  /// is a misfit when a pose nearby, turned by more than misfit_turn_deg, puts the latest scans on
-  /// the walls beyond doubt and 0.3 (dense_sure_hit_fraction - dense_min_hit_fraction) better.
+  /// `place`'s dense thresholds. When the best of the poses searched around the fix is turned
+  /// from it by more than misfit_turn_deg and puts the latest scans on the walls beyond doubt
+  /// (dense_sure_hit_fraction) and 0.3 (dense_sure_hit_fraction - dense_min_hit_fraction) better
+  /// than the fix, it becomes a suspect; the next check is a misfit when the suspect does so again
+  /// with that check's latest scans. Otherwise the fix fits when the recent scans pass the veto
+  /// (dense_min_hit_fraction); kUnknown when they do not.
   TrackCheckResult Check(const PlaceRecognizer& recognizer, const PlaceRecognitionConfig& place,
-                         const Pose2& T_world_odom, const QueryExclusion& exclusion) const;
+                         const Pose2& T_world_odom, const QueryExclusion& exclusion);
 
-  void Reset() { scans_.clear(); }
+  void Reset() {
+    scans_.clear();
+    suspect_T_world_odom_.reset();
+  }
 
  private:
   struct RecentScan {
@@ -69,8 +78,14 @@ class TrackCheck {
     QueryScanPoints points;  // robot frame
     int scan_id = -1;
   };
+  void Judge(const DenseReference& reference, const std::vector<QueryScanPoints>& latest,
+             const Eigen::Vector2d& robot_m, const PlaceRecognitionConfig& place,
+             const Pose2& T_world_odom, TrackCheckResult& result);
+
   double misfit_turn_rad_ = 0.0;
   std::deque<RecentScan> scans_;
+  // The fix a check's search preferred (a misfit if the next check's scans confirm it).
+  std::optional<Pose2> suspect_T_world_odom_;
 };
 
 }  // namespace keyplace

@@ -70,10 +70,10 @@ class DenseReference {
   /// The query scans put into the reference frame by T_ref_query.
   DenseScore Score(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans) const;
 
-  /// Score's hit_fraction alone (no beam is traced), from every `stride`-th endpoint: cheap
-  /// enough to compare thousands of poses.
-  double HitFraction(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
-                     std::size_t stride = 1) const;
+  /// Score's endpoints and hit_fraction alone (no beam is traced), from every `stride`-th
+  /// endpoint: cheap enough to compare thousands of poses.
+  DenseScore Hits(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
+                  std::size_t stride = 1) const;
 
   bool empty() const { return flags_.empty(); }
 
