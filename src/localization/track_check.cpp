@@ -57,14 +57,8 @@ std::vector<Eigen::Vector2i> WorldCells(const std::vector<Place>& places,
   std::vector<Eigen::Vector2i> cells;
   for (const std::size_t p : chosen) {
     const Place& place = places[p];
-    const PointMapper to_world(place.T_world_place);
-    for (const Eigen::Vector2i& cell : place.occupancy_cells) {
-      const Eigen::Vector2d centre =
-          (cell.cast<double>().array() + 0.5).matrix() * place.occupancy_cell_m;
-      const Eigen::Vector2d point = to_world(centre);
-      cells.emplace_back(static_cast<int>(std::floor(point.x() / cell_m)),
-                         static_cast<int>(std::floor(point.y() / cell_m)));
-    }
+    AppendCellsInFrame(place.occupancy_cells, place.occupancy_cell_m, place.T_world_place, cell_m,
+                       cells);
   }
   return cells;
 }

@@ -41,6 +41,18 @@ QueryScanPoints InQueryFrame(const QueryScanPoints& points, const Pose2& T_query
   return out;
 }
 
+void AppendCellsInFrame(const std::vector<Eigen::Vector2i>& cells, double cell_m,
+                        const Pose2& T_to_from, double out_cell_m,
+                        std::vector<Eigen::Vector2i>& out) {
+  const PointMapper to(T_to_from);
+  out.reserve(out.size() + cells.size());
+  for (const Eigen::Vector2i& cell : cells) {
+    const Eigen::Vector2d point = to((cell.cast<double>().array() + 0.5).matrix() * cell_m);
+    out.emplace_back(static_cast<int>(std::floor(point.x() / out_cell_m)),
+                     static_cast<int>(std::floor(point.y() / out_cell_m)));
+  }
+}
+
 DenseReference::DenseReference(const std::vector<Eigen::Vector2i>& cells, double cell_size_m)
     : cell_size_m_(cell_size_m) {
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {

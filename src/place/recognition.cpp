@@ -240,14 +240,8 @@ DenseReference ReferenceOccupancy(const std::vector<Place>& places, int place_in
   const double cell_m = place.occupancy_cell_m;
   for (int n : neighbours) {
     const Place& neighbour = places[static_cast<std::size_t>(n)];
-    const PointMapper T_place_neighbour(Between(place.T_world_place, neighbour.T_world_place));
-    for (const Eigen::Vector2i& cell : neighbour.occupancy_cells) {
-      const Eigen::Vector2d centre =
-          (cell.cast<double>().array() + 0.5).matrix() * neighbour.occupancy_cell_m;
-      const Eigen::Vector2d point = T_place_neighbour(centre);
-      cells.emplace_back(static_cast<int>(std::floor(point.x() / cell_m)),
-                         static_cast<int>(std::floor(point.y() / cell_m)));
-    }
+    AppendCellsInFrame(neighbour.occupancy_cells, neighbour.occupancy_cell_m,
+                       Between(place.T_world_place, neighbour.T_world_place), cell_m, cells);
   }
   return DenseReference(cells, cell_m);
 }

@@ -11,6 +11,7 @@
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/io/carmen_log.hpp"
+#include "keyplace/mapping/global_mapper.hpp"
 #include "registration/synthetic_scene.hpp"
 
 namespace keyplace::testing {
@@ -122,6 +123,27 @@ inline SimulatedDrive Simulate(const std::vector<Segment>& world, const std::vec
     run.scans.push_back(std::move(scan));
   }
   return run;
+}
+
+// The map of the two rooms: round room A, along the corridor, round room B (true poses).
+inline GlobalMap TwoRoomsMap() {
+  const SimulatedDrive mapping = Simulate(TwoRooms(),
+                                          Drive({{-10, 2},
+                                                 {-12, 2},
+                                                 {-12, -2},
+                                                 {-8, -2},
+                                                 {-8, 2},
+                                                 {-10, 2},
+                                                 {-10, 8},
+                                                 {10, 8},
+                                                 {10, 2},
+                                                 {12, 2},
+                                                 {12, -2},
+                                                 {8, -2},
+                                                 {8, 2},
+                                                 {10, 2}}),
+                                          1);
+  return BuildGlobalMap({mapping.scans, mapping.truth, mapping.keypoints}, MappingConfig{});
 }
 
 }  // namespace keyplace::testing

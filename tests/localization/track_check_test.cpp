@@ -24,7 +24,6 @@ using testing::TwoRooms;
 // Room A, the corridor and room B: the map. The query runs the corridor from its east end to
 // its west end and down into room A.
 struct World {
-  SimulatedDrive mapping;
   GlobalMap map;
   SimulatedDrive query;
 };
@@ -32,26 +31,8 @@ struct World {
 const World& SharedWorld() {
   static const World world = [] {
     World w;
-    const std::vector<testing::Segment> segments = TwoRooms();
-    w.mapping = Simulate(segments,
-                         Drive({{-10, 2},
-                                {-12, 2},
-                                {-12, -2},
-                                {-8, -2},
-                                {-8, 2},
-                                {-10, 2},
-                                {-10, 8},
-                                {10, 8},
-                                {10, 2},
-                                {12, 2},
-                                {12, -2},
-                                {8, -2},
-                                {8, 2},
-                                {10, 2}}),
-                         1);
-    w.map =
-        BuildGlobalMap({w.mapping.scans, w.mapping.truth, w.mapping.keypoints}, MappingConfig{});
-    w.query = Simulate(segments, Drive({{13, 8}, {-10, 8}, {-10, 2}, {-12, 2}, {-12, -2}}), 2);
+    w.map = testing::TwoRoomsMap();
+    w.query = Simulate(TwoRooms(), Drive({{13, 8}, {-10, 8}, {-10, 2}, {-12, 2}, {-12, -2}}), 2);
     return w;
   }();
   return world;

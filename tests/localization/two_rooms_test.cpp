@@ -47,24 +47,7 @@ struct QueryOutcome {
 // round it, up the stub, west along the corridor.
 QueryOutcome KidnappedIntoRoomB(const LocalizerConfig& config) {
   const std::vector<Segment> world = TwoRooms();
-  const SimulatedDrive mapping = Simulate(world,
-                                          Drive({{-10, 2},
-                                                 {-12, 2},
-                                                 {-12, -2},
-                                                 {-8, -2},
-                                                 {-8, 2},
-                                                 {-10, 2},
-                                                 {-10, 8},
-                                                 {10, 8},
-                                                 {10, 2},
-                                                 {12, 2},
-                                                 {12, -2},
-                                                 {8, -2},
-                                                 {8, 2},
-                                                 {10, 2}}),
-                                          1);
-  const GlobalMap map =
-      BuildGlobalMap({mapping.scans, mapping.truth, mapping.keypoints}, MappingConfig{});
+  const GlobalMap map = testing::TwoRoomsMap();
   const SimulatedDrive query =
       Simulate(world, Drive({{12, -2}, {8, -2}, {8, 2}, {10, 2}, {10, 8}, {-3, 8}}), 2);
   // Odometry starts where the robot woke up: the map <- odometry transform is unknown.

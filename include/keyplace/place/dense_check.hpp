@@ -40,6 +40,12 @@ QueryScanPoints DenseScanPoints(const LaserScan& scan);
 /// `points` (robot frame) seen from T_query_robot: in the query frame.
 QueryScanPoints InQueryFrame(const QueryScanPoints& points, const Pose2& T_query_robot);
 
+/// Appends occupied `cells` (indices of `cell_m` in a frame `from`) to `out` as the cells of
+/// `out_cell_m` in a frame `to` holding their centres (T_to_from: `from` seen from `to`).
+void AppendCellsInFrame(const std::vector<Eigen::Vector2i>& cells, double cell_m,
+                        const Pose2& T_to_from, double out_cell_m,
+                        std::vector<Eigen::Vector2i>& out);
+
 struct DenseScore {
   // Query endpoints inside the reference's area (its occupied cells' bounding box): the others
   // fall where the reference never looked and say nothing.
