@@ -35,7 +35,7 @@ Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
     : localizer_(map, config, features), filter_(config.fix), track_(config.fix.agree_deg) {}
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
-  track_.AddScan(scan, T_odom_robot, -1);
+  RememberForTrackCheck(scan, T_odom_robot, -1);
   RelocalizationUpdate update =
       filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
   CheckTrack(T_odom_robot, update);
@@ -44,7 +44,7 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
-  track_.AddScan(scan, T_odom_robot, scan_id);
+  RememberForTrackCheck(scan, T_odom_robot, scan_id);
   RelocalizationUpdate update = filter_.Update(
       localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id), T_odom_robot);
   CheckTrack(T_odom_robot, update);
@@ -57,6 +57,13 @@ void Relocalizer::Reset() {
   track_.Reset();
   last_T_odom_robot_.reset();
   since_check_m_ = 0.0;
+}
+
+void Relocalizer::RememberForTrackCheck(const LaserScan& scan, const Pose2& T_odom_robot,
+                                        int scan_id) {
+  if (localizer_.config().fix.track_check_every_m > 0.0) {
+    track_.AddScan(scan, T_odom_robot, scan_id);
+  }
 }
 
 // A new fix passed the dense check of its answers: the first check comes a check distance later.
@@ -75,7 +82,7 @@ void Relocalizer::CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& up
   if (policy.track_check_every_m <= 0.0 || since_check_m_ < policy.track_check_every_m) return;
   since_check_m_ = 0.0;
   const TrackCheckResult check = track_.Check(localizer_.recognizer(), localizer_.config().place,
-                                              update.T_world_odom, exclusion_);
+                                              update.T_world_odom, localizer_.exclusion());
   update.track_fit = check.fit;
   if (check.fit != TrackFit::kMisfit) return;
   // The odometry, not the map, went wrong: the query being built spans the error too, and its

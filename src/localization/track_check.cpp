@@ -63,14 +63,15 @@ std::vector<Eigen::Vector2i> WorldCells(const std::vector<Place>& places,
   return cells;
 }
 
-// The best hit fraction of `scans` (world frame, as the fix put them) over the poses of the search
-// window that keep at least `min_endpoints` of them in the reference's area: turned about the
-// robot's position `robot_m`, then shifted. The fix's own pose is in it.
-std::pair<double, Pose2> BestNearby(const DenseReference& reference,
-                                    const std::vector<QueryScanPoints>& scans,
-                                    const Eigen::Vector2d& robot_m, int min_endpoints) {
-  double best = 0.0;
-  Pose2 best_correction;  // world frame: applied to the fix's world poses
+// The best hits of `scans` (world frame, as the fix put them) over the poses of the search window
+// that keep at least `min_endpoints` of them in the reference's area (turned about the robot's
+// position `robot_m`, then shifted; the fix's own pose is in it), with the correction (world
+// frame) that gives them. No pose keeps enough: hit_fraction 0.
+std::pair<DenseScore, Pose2> BestNearby(const DenseReference& reference,
+                                        const std::vector<QueryScanPoints>& scans,
+                                        const Eigen::Vector2d& robot_m, int min_endpoints) {
+  DenseScore best;
+  Pose2 best_correction;
   for (int t = -kSearchTurnSteps; t <= kSearchTurnSteps; ++t) {
     const Pose2 turn_about_robot = Pose2(robot_m.x(), robot_m.y(), t * kSearchTurnStepRad) *
                                    Pose2(-robot_m.x(), -robot_m.y(), 0.0);
@@ -79,8 +80,8 @@ std::pair<double, Pose2> BestNearby(const DenseReference& reference,
         const Pose2 correction =
             Pose2(i * kSearchShiftStepM, j * kSearchShiftStepM, 0.0) * turn_about_robot;
         const DenseScore hits = reference.Hits(correction, scans, kSearchStride);
-        if (hits.endpoints >= min_endpoints && hits.hit_fraction > best) {
-          best = hits.hit_fraction;
+        if (hits.endpoints >= min_endpoints && hits.hit_fraction > best.hit_fraction) {
+          best = hits;
           best_correction = correction;
         }
       }
@@ -182,14 +183,11 @@ void TrackCheck::Judge(const DenseReference& reference, const std::vector<QueryS
       return;
     }
   }
-  const auto [best_hit, correction] = BestNearby(reference, latest, robot_m, min_endpoints);
-  if (best_hit > result.best_hit_fraction) {
-    result.best_hit_fraction = best_hit;
+  const auto [best, correction] = BestNearby(reference, latest, robot_m, min_endpoints);
+  if (best.hit_fraction > result.best_hit_fraction) {
+    result.best_hit_fraction = best.hit_fraction;
     result.T_world_odom_best = correction * T_world_odom;
   }
-  DenseScore best;  // BestNearby only weighs poses with min_endpoints
-  best.endpoints = min_endpoints;
-  best.hit_fraction = best_hit;
   if (much_better(best) && std::abs(WrapAngle(correction.theta)) > misfit_turn_rad_) {
     suspect_T_world_odom_ = correction * T_world_odom;
   } else if (result.score.hit_fraction >= place.dense_min_hit_fraction) {

@@ -131,6 +131,7 @@ class GlobalLocalizer {
   void Reset();
 
   void set_exclusion(QueryExclusion exclusion) { exclusion_ = std::move(exclusion); }
+  const QueryExclusion& exclusion() const { return exclusion_; }
 
   std::size_t buffered_scans() const { return builder_.size(); }
   const PlaceRecognizer& recognizer() const { return *recognizer_; }

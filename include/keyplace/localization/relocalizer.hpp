@@ -169,21 +169,19 @@ class Relocalizer {
   /// Forgets everything: fix, hypotheses and the query being built (the robot was kidnapped).
   void Reset();
 
-  void set_exclusion(QueryExclusion exclusion) {
-    exclusion_ = exclusion;
-    localizer_.set_exclusion(std::move(exclusion));
-  }
+  void set_exclusion(QueryExclusion exclusion) { localizer_.set_exclusion(std::move(exclusion)); }
   FixStatus status() const { return filter_.status(); }
   const GlobalLocalizer& localizer() const { return localizer_; }
 
  private:
+  // The beams the track check needs (none when it is off).
+  void RememberForTrackCheck(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   // The track check of FixPolicy::track_check_every_m, on `update` of the scan just added.
   void CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& update);
 
   GlobalLocalizer localizer_;
   FixFilter filter_;
   TrackCheck track_;
-  QueryExclusion exclusion_;
   std::optional<Pose2> last_T_odom_robot_;
   double since_check_m_ = 0.0;  // odometry since the fix or its last check
 };
