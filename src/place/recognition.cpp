@@ -324,17 +324,19 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
   result.dense_sure = dense_applies &&
                       result.dense.hit_fraction >= config.dense_sure_hit_fraction &&
                       result.dense.see_through_fraction <= config.dense_sure_see_through;
-  if (!result.dense_sure && gamma.gamma < v.min_gamma) return std::nullopt;
+  result.dense_supported = dense_applies;
   const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
                                             estimate.T_ref_cur, config.ransac.inlier_distance_m);
-  if (coverage < v.min_coverage) return std::nullopt;  // third check (ours)
+  // Second check, then the third (ours). A candidate failing them is kept when the beams support
+  // it: a weak answer (PlaceMatch::weak).
+  result.verified = (result.dense_sure || gamma.gamma >= v.min_gamma) && coverage >= v.min_coverage;
+  if (!result.verified && !result.dense_supported) return std::nullopt;
   result.place_index = candidate.place_index;
   result.pairs = static_cast<int>(candidate.pairs.size());
   result.mean_pair_distance = candidate.mean_distance;
   result.consensus = consensus;
   result.gamma = gamma.gamma;
   result.reference_coverage = coverage;
-  result.verified = true;
   result.T_ref_cur = estimate.T_ref_cur;
   result.estimated_pose = place.T_world_place * estimate.T_ref_cur * v.query.T_first_evaluated;
   result.estimated_pose_covariance = ComposedCovariance(
@@ -348,7 +350,7 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
 // A verified candidate passes a threshold's second check when its beams confirm it beyond doubt,
 // else by its gamma (thresholds of a sweep differ in gamma_min; the dense veto is the same).
 bool PassesSecondCheck(const CandidateResult& result, double min_gamma) {
-  return result.dense_sure || result.gamma >= min_gamma;
+  return result.verified && (result.dense_sure || result.gamma >= min_gamma);
 }
 
 // The threads a parallel loop started here may use (the arena's, within the global control).
@@ -444,6 +446,14 @@ void GatherVerified(const Verification& v, const std::vector<int>& order, double
   }
 }
 
+// Two candidates name different robot poses (PlaceRecognitionConfig::distinct_*).
+bool Distinct(const CandidateResult& a, const CandidateResult& b,
+              const PlaceRecognitionConfig& config) {
+  const Pose2 delta = Between(a.estimated_pose, b.estimated_pose);
+  return TranslationNorm(delta) > config.distinct_distance_m ||
+         std::abs(delta.theta) > config.distinct_angle_deg * M_PI / 180.0;
+}
+
 // The answer among match.verified_candidates: the best score, unless a distinct one comes close.
 void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig& config,
                   PlaceMatch& match) {
@@ -454,13 +464,9 @@ void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig
   for (const CandidateResult& candidate : match.verified_candidates) {
     if (candidate.score > best->score) best = &candidate;
   }
-  const double distinct_angle = config.distinct_angle_deg * M_PI / 180.0;
   double second = 0.0;
   for (const CandidateResult& candidate : match.verified_candidates) {
-    const Pose2 delta = Between(best->estimated_pose, candidate.estimated_pose);
-    const bool distinct = TranslationNorm(delta) > config.distinct_distance_m ||
-                          std::abs(delta.theta) > distinct_angle;
-    if (distinct) second = std::max(second, candidate.score);
+    if (Distinct(*best, candidate, config)) second = std::max(second, candidate.score);
   }
   match.verified = true;
   match.place_index = best->place_index;
@@ -482,6 +488,33 @@ void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig
   match.confidence = consensus_factor * best->gamma * gap;
   match.ambiguous = second > 0.0 && second >= config.ambiguity_ratio * best->score;
   match.found = !match.ambiguous && match.confidence >= config.min_confidence;
+}
+
+// PlaceMatch::weak among the candidates of `order` that went through verification. Consensus,
+// not the score, ranks them: their gamma is what may be missing.
+void ChooseWeak(const std::vector<int>& order, const VerifiedPlaces& verified,
+                const PlaceRecognitionConfig& config, PlaceMatch& match) {
+  std::vector<const CandidateResult*> supported;
+  for (int p : order) {
+    if (verified.Done(p) && verified.Result(p) && verified.Result(p)->dense_supported) {
+      supported.push_back(&*verified.Result(p));
+    }
+  }
+  if (supported.empty()) return;
+  const CandidateResult* best = supported.front();
+  for (const CandidateResult* candidate : supported) {
+    if (candidate->consensus > best->consensus) best = candidate;
+  }
+  int second = 0;
+  for (const CandidateResult* candidate : supported) {
+    if (Distinct(*best, *candidate, config)) second = std::max(second, candidate->consensus);
+  }
+  const double ratio = static_cast<double>(second) / static_cast<double>(best->consensus);
+  if (second > 0 && ratio >= config.ambiguity_ratio) return;
+  match.weak = *best;
+  const double consensus_factor =
+      std::min(1.0, static_cast<double>(best->consensus) / config.confidence_consensus);
+  match.weak_confidence = consensus_factor * best->gamma * (1.0 - ratio);
 }
 
 void CheckThresholds(const std::vector<RecognitionThresholds>& thresholds) {
@@ -572,6 +605,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   for (std::size_t k = 0; k < thresholds.size(); ++k) {
     GatherVerified(verification, orders[k], gamma_of(thresholds[k]), exclude, verified, matches[k]);
     ChooseAnswer(places_, config_, matches[k]);
+    ChooseWeak(orders[k], verified, config_, matches[k]);
   }
   const double seconds_verification = SecondsSince(verify_start);
   const double seconds = SecondsSince(start);

@@ -209,5 +209,43 @@ TEST(DenseCheck, RefusesALookAlikeWhoseWallsDoNotFit) {
   EXPECT_FALSE(match.verified);
 }
 
+// Beams that support the pose but not beyond doubt, and no gamma: no answer, but a weak one.
+TEST(DenseCheck, APoseTheBeamsSupportWithoutGammaIsAWeakAnswer) {
+  const auto [place, query] = SparseMatch(Room());
+  PlaceRecognitionConfig never_sure;
+  never_sure.dense_sure_hit_fraction = 1.0;
+  never_sure.dense_sure_see_through = 0.0;
+  const PlaceMatch match = PlaceRecognizer({place}, never_sure).Recognize(query);
+  EXPECT_FALSE(match.verified);  // gamma 0 < 0.15, and the beams are not "sure"
+  ASSERT_TRUE(match.weak.has_value());
+  EXPECT_TRUE(match.weak->dense_supported);
+  EXPECT_FALSE(match.weak->verified);
+  EXPECT_EQ(match.weak->consensus, 12);
+  EXPECT_EQ(match.weak_confidence, 0.0);  // gamma 0
+  const Pose2& expected = kQueryPoses.front();
+  EXPECT_NEAR(match.weak->estimated_pose.x, expected.x, 1e-6);
+  EXPECT_NEAR(match.weak->estimated_pose.y, expected.y, 1e-6);
+
+  // Without beams nothing supports the pose: no weak answer either.
+  PlaceQuery without_scans = query;
+  without_scans.scans.clear();
+  EXPECT_FALSE(PlaceRecognizer({place}, never_sure).Recognize(without_scans).weak.has_value());
+
+  // The same place twice, 5 m apart in the map: the beams fit both, which is no answer.
+  Place twin = place;
+  twin.id = 7;
+  twin.T_world_place = Pose2(5.0, 0.0, 0.0) * place.T_world_place;
+  EXPECT_FALSE(PlaceRecognizer({place, twin}, never_sure).Recognize(query).weak.has_value());
+}
+
+TEST(DenseCheck, AVetoedPoseIsNoWeakAnswer) {
+  const std::vector<Segment> other{{{0, 0}, {12, 0}}, {{12, 0}, {12, 7}}, {{12, 7}, {0, 7}},
+                                   {{0, 7}, {0, 0}},  {{3, 2}, {4, 2}},   {{4, 2}, {4, 3}}};
+  const auto [place, query] = SparseMatch(other);
+  const PlaceMatch match = PlaceRecognizer({place}, PlaceRecognitionConfig{}).Recognize(query);
+  EXPECT_FALSE(match.verified);
+  EXPECT_FALSE(match.weak.has_value());
+}
+
 }  // namespace
 }  // namespace keyplace

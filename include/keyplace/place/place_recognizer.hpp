@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -112,6 +113,9 @@ struct CandidateResult {
   bool dense_checked = false;
   bool dense_sure = false;
   DenseScore dense;
+  // The dense check applied (enough of the query's endpoints in the candidate's area) and did not
+  // veto the pose: the beams support it, whatever gamma says (PlaceMatch::weak).
+  bool dense_supported = false;
   bool verified = false;  // passed all checks
   Pose2 T_ref_cur;
   Pose2 estimated_pose;  // Eq. (9)
@@ -155,6 +159,16 @@ struct PlaceMatch {
   double seconds_verification = 0.0;
   double seconds = 0.0;
   std::vector<CandidateResult> verified_candidates;  // those that passed both checks
+  // The weak answer: of the candidates whose RANSAC passed the first check and whose pose the
+  // dense check supports (CandidateResult::dense_supported), verified or not, the one with the
+  // largest consensus; nullopt when there is none, or when a distinct one (distinct_*) has at
+  // least ambiguity_ratio of its consensus. Where gamma or the coverage check rejects the right
+  // pose (open halls keep few stable keypoints) it is still named here, as evidence that answers
+  // of later queries can confirm (Relocalizer; docs/LOCALIZATION.md, "Weak answers").
+  std::optional<CandidateResult> weak;
+  // As confidence, for the weak answer (its gamma, consensus and the distinct runner-up's
+  // consensus in place of the score).
+  double weak_confidence = 0.0;
 };
 
 /// Returns true for places the query must not be matched with (self-matches).
