@@ -89,6 +89,11 @@ void BindLocalizationResult(py::module_& module) {
       .def_property_readonly(
           "scan_ids", [](const LocalizationResult& r) { return VectorArray(r.scan_ids); },
           "The ids given to add_scan for the query's scans (-1 when none was given).")
+      .def_property_readonly(
+          "weak_T_world_odom",
+          [](const LocalizationResult& r) { return OptionalPoseArray(r.weak_T_world_odom); },
+          "Not found, but a weak answer (keypoints and beams support it, gamma did not pass): "
+          "its map <- odometry correction; None otherwise. The Relocalizer adds these up.")
       .def_readonly("match", &LocalizationResult::match, "The PlaceMatch details.")
       .def("__repr__", [](const LocalizationResult& r) {
         return std::string("<keyplace.LocalizationResult ") + (r.found ? "found" : "not found") +

@@ -23,6 +23,9 @@ LocalizationResult ResultOf(PlaceMatch match, const Pose2& T_odom_latest) {
     result.T_world_robot = result.match.estimated_pose;
     result.T_world_odom = result.T_world_robot * T_odom_latest.inverse();
   }
+  if (!result.found && result.match.weak) {
+    result.weak_T_world_odom = result.match.weak->estimated_pose * T_odom_latest.inverse();
+  }
   return result;
 }
 

@@ -17,6 +17,16 @@ LocalizationResult Answer(const Pose2& T_world_odom, double confidence = 0.5) {
   return answer;
 }
 
+// An answer not accepted that names a weak pose (LocalizationResult::weak_T_world_odom).
+LocalizationResult WeakAnswer(const Pose2& T_world_odom, long long query_id = -1,
+                              double confidence = 0.05) {
+  LocalizationResult answer;
+  answer.weak_T_world_odom = T_world_odom;
+  answer.match.weak_confidence = confidence;
+  answer.query_id = query_id;
+  return answer;
+}
+
 // The robot drives along +x in its odometry frame, 0.25 m per scan.
 Pose2 Odometry(int scan) { return {0.25 * scan, 0.0, 0.0}; }
 
@@ -205,6 +215,74 @@ TEST(FixFilter, OneConfirmationFixesAtOnce) {
   policy.confirmations = 1;
   FixFilter filter(policy);
   EXPECT_TRUE(filter.Update(Answer(kTrue), Odometry(0)).new_fix);
+}
+
+// Weak answers second an accepted one from another look (more than agree_m of odometry away):
+// alone, however many agree, they make no fix.
+TEST(FixFilter, WeakAnswersAloneNeverMakeAFix) {
+  FixFilter filter;
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 1), Odometry(0)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 2), Odometry(3)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 3), Odometry(8)).status, FixStatus::kSearching);
+  const RelocalizationUpdate update = filter.Update(AnswerOfQuery(kTrue, 4), Odometry(16));
+  ASSERT_EQ(update.status, FixStatus::kFixed);
+  EXPECT_TRUE(update.new_fix);
+  // The accepted answer and the three weak ones, each more than agree_m from it.
+  EXPECT_NEAR(update.confidence, 1.0 - 0.5 * 0.95 * 0.95 * 0.95, 1e-12);
+}
+
+TEST(FixFilter, AWeakAnswerFromAnotherLookSecondsAnAcceptedOne) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  // 0.5 m on: nearly the same look (a robot turning on the spot sees one room several times).
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 2), Odometry(2)).status, FixStatus::kSearching);
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 3), Odometry(5)).new_fix);
+}
+
+TEST(FixFilter, AWeakAnswerThatDisagreesGivesNoFix) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  EXPECT_EQ(filter.Update(WeakAnswer(kWrong, 2), Odometry(8)).status, FixStatus::kSearching);
+}
+
+TEST(FixFilter, AWeakAnswerIsNoFixEvenWithOneConfirmation) {
+  FixPolicy policy;
+  policy.confirmations = 1;
+  FixFilter filter(policy);
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 1, 0.99), Odometry(0)).status, FixStatus::kSearching);
+  EXPECT_TRUE(filter.Update(AnswerOfQuery(kTrue, 2), Odometry(8)).new_fix);
+}
+
+// A query's weak answer that its own later accepted answer contradicts does not make the query
+// ambiguous (only accepted answers of one query that disagree do).
+TEST(FixFilter, AnEarlierWeakAnswerOfTheQueryIsReplacedNotContradicted) {
+  FixFilter filter;
+  filter.Update(WeakAnswer(kWrong, 1), Odometry(0));
+  const RelocalizationUpdate update = filter.Update(AnswerOfQuery(kTrue, 1), Odometry(4));
+  EXPECT_FALSE(update.self_contradicted);
+  EXPECT_TRUE(filter.Update(AnswerOfQuery(kTrue, 2), Odometry(8)).new_fix);
+}
+
+TEST_F(FixedFilter, AWeakAnswerConfirmsTheFix) {
+  for (int scan = 6; scan < 40; ++scan) filter_.Update(std::nullopt, Odometry(scan));
+  const RelocalizationUpdate update = filter_.Update(WeakAnswer(kTrue), Odometry(40));
+  EXPECT_TRUE(update.confirmed);
+  EXPECT_EQ(update.unconfirmed_m, 0.0);
+}
+
+// Along a corridor with doors at regular spacing weak answers from several looks can agree on one
+// shifted pose: they never overturn a fix, however many and however confident.
+TEST_F(FixedFilter, WeakContradictionsNeverOverturnTheFix) {
+  for (int scan = 10; scan <= 30; scan += 5) {
+    const RelocalizationUpdate update =
+        filter_.Update(WeakAnswer(kWrong, scan, 0.95), Odometry(scan));
+    EXPECT_TRUE(update.contradicted);
+    EXPECT_FALSE(update.lost);
+    ASSERT_EQ(update.status, FixStatus::kFixed);
+    EXPECT_NEAR(update.T_world_odom.x, kTrue.x, 1e-9);
+  }
+  // An accepted challenger is not seconded by them either: one alone does not overturn the fix.
+  EXPECT_FALSE(filter_.Update(AnswerOfQuery(kWrong, 99), Odometry(36)).lost);
 }
 
 TEST(FixFilter, RejectsInvalidPolicies) {

@@ -63,6 +63,15 @@ class LocalizationTest(unittest.TestCase):
         self.assertGreater(len(expected), 10)
         self.assertEqual(got, expected)
 
+    def test_weak_answers_come_only_with_answers_not_accepted(self):
+        for _, answer in self.answers:
+            weak = answer.weak_T_world_odom
+            if answer.found:
+                self.assertIsNone(weak)
+            elif weak is not None:
+                self.assertEqual(weak.shape, (3,))
+                self.assertTrue(np.all(np.isfinite(weak)))
+
     def test_range_arrays_give_the_answers_of_scans(self):
         localizer = keyplace.GlobalLocalizer(keyplace.load_map(self.map_path))
         first_index, first_answer = self.answers[0]

@@ -94,6 +94,10 @@ struct LocalizationResult {
   // Answers with the same id came from one query (LocalizerConfig::query_every_m) and share
   // scans, so they are not independent evidence; -1: independent of every other answer.
   long long query_id = -1;
+  // When the match was not accepted but names a weak answer (PlaceMatch::weak, its confidence
+  // match.weak_confidence): the map <- odometry correction of that pose. Alone it is no fix; the
+  // Relocalizer adds such answers up (docs/LOCALIZATION.md, "Weak answers").
+  std::optional<Pose2> weak_T_world_odom;
   PlaceMatch match;  // all the details of the recognition
 };
 

@@ -68,7 +68,8 @@ struct RelocalizationUpdate {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   // The localizer's answer when a query submap completed with this scan.
   std::optional<LocalizationResult> answer;
-  // The answer was accepted and agreed with the fix (confirmation) or contradicted it.
+  // The answer (accepted, or weak: LocalizationResult::weak_T_world_odom) agreed with the fix
+  // (confirmation) or contradicted it.
   bool confirmed = false;
   bool contradicted = false;
   // The answer came from a query whose accepted answers disagree with each other (it sees a
@@ -109,11 +110,16 @@ class FixFilter {
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     Pose2 T_odom_robot;
     long long query_id = -1;  // LocalizationResult::query_id
+    bool weak = false;        // a weak answer (LocalizationResult::weak_T_world_odom)
   };
+  // The hypothesis an answer names: its accepted match, or else its weak answer.
+  Hypothesis HypothesisOf(const LocalizationResult& answer, const Pose2& T_odom_robot) const;
 
   void Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
               RelocalizationUpdate& update);
   void Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot, RelocalizationUpdate& update);
+  // Whether `latest` and the hypotheses agreeing with it are enough for a fix.
+  bool Enough(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest) const;
   // Whether two hypotheses name the same robot pose now, within the policy's tolerances.
   bool Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const;
   // Drops the earlier answers of `answer`'s query from the pools; false when the query
