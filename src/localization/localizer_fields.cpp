@@ -12,7 +12,7 @@ const ConfigFields<FixPolicy>& FixPolicyFields() {
     ConfigFields<C> table("FixPolicy");
     table
         .Int("confirmations", &C::confirmations, "",
-             "accepted answers that must agree through odometry before a fix")
+             "answers that must agree through odometry before a fix (one accepted)")
         .Double("agree_m", &C::agree_m, "m", "two answers agree within this distance (now) ...")
         .Double("agree_per_m", &C::agree_per_m, "m/m",
                 "... plus this per metre travelled between them (odometry drift)")

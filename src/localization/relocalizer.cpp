@@ -158,6 +158,8 @@ FixFilter::Hypothesis FixFilter::HypothesisOf(const LocalizationResult& answer,
             odometry_m_,         answer.match.estimated_pose_covariance,
             T_odom_robot,        answer.query_id};
   }
+  // Zero only for results built by hand (the localizer sets both): the fix then claims the
+  // filter's own variances alone.
   const Eigen::Matrix3d covariance = answer.match.weak
                                          ? answer.match.weak->estimated_pose_covariance
                                          : Eigen::Matrix3d::Zero().eval();
@@ -219,6 +221,8 @@ void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
                       RelocalizationUpdate& update) {
   const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_,
                        FixCovarianceAt(T_odom_robot), T_odom_robot};
+  // A weak answer that agrees confirms the fix even from the spot of the last confirmation: the
+  // fix was made with an accepted answer, and a confirmation only averages within the agreement.
   if (Agree(fix, hypothesis, T_odom_robot)) {
     Confirm(hypothesis, T_odom_robot);
     update.confirmed = true;

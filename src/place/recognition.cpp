@@ -262,7 +262,9 @@ void ScoreDense(const Verification& v, int place_index, const std::vector<int>& 
 }
 
 // RANSAC and the three checks of one candidate (the place's own seed: the answer does not depend
-// on which other candidates are verified, nor in which order). nullopt: not verified.
+// on which other candidates are verified, nor in which order), with the lowest gamma_min of the
+// thresholds. nullopt: neither verified nor supported by the beams (CandidateResult::verified,
+// dense_supported).
 std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Candidate& candidate,
                                                const std::vector<int>& neighbours) {
   const PlaceRecognitionConfig& config = v.config;
@@ -324,12 +326,14 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
   result.dense_sure = dense_applies &&
                       result.dense.hit_fraction >= config.dense_sure_hit_fraction &&
                       result.dense.see_through_fraction <= config.dense_sure_see_through;
-  result.dense_supported = dense_applies;
-  const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
-                                            estimate.T_ref_cur, config.ransac.inlier_distance_m);
   // Second check, then the third (ours). A candidate failing them is kept when the beams support
   // it: a weak answer (PlaceMatch::weak).
-  result.verified = (result.dense_sure || gamma.gamma >= v.min_gamma) && coverage >= v.min_coverage;
+  result.dense_supported = dense_applies;
+  const bool second_check = result.dense_sure || gamma.gamma >= v.min_gamma;
+  if (!second_check && !result.dense_supported) return std::nullopt;
+  const double coverage = ReferenceCoverage(*reference_positions, v.match_positions,
+                                            estimate.T_ref_cur, config.ransac.inlier_distance_m);
+  result.verified = second_check && coverage >= v.min_coverage;
   if (!result.verified && !result.dense_supported) return std::nullopt;
   result.place_index = candidate.place_index;
   result.pairs = static_cast<int>(candidate.pairs.size());
@@ -490,15 +494,17 @@ void ChooseAnswer(const std::vector<Place>& places, const PlaceRecognitionConfig
   match.found = !match.ambiguous && match.confidence >= config.min_confidence;
 }
 
-// PlaceMatch::weak among the candidates of `order` that went through verification. Consensus,
-// not the score, ranks them: their gamma is what may be missing.
-void ChooseWeak(const std::vector<int>& order, const VerifiedPlaces& verified,
+// PlaceMatch::weak among the candidates of `order` that the sequential loop verifies
+// (match.candidates_verified: with kFirstVerified, a wave may verify more, depending on the
+// threads). Consensus, not the score, ranks them: their gamma is what may be missing.
+void ChooseWeak(const std::vector<int>& order, const VerifiedPlaces& verified, double min_gamma,
                 const PlaceRecognitionConfig& config, PlaceMatch& match) {
   std::vector<const CandidateResult*> supported;
-  for (int p : order) {
-    if (verified.Done(p) && verified.Result(p) && verified.Result(p)->dense_supported) {
-      supported.push_back(&*verified.Result(p));
-    }
+  const auto counted = static_cast<std::size_t>(match.candidates_verified);
+  for (std::size_t k = 0; k < std::min(order.size(), counted); ++k) {
+    if (!verified.Done(order[k])) continue;
+    const std::optional<CandidateResult>& result = verified.Result(order[k]);
+    if (result && result->dense_supported) supported.push_back(&*result);
   }
   if (supported.empty()) return;
   const CandidateResult* best = supported.front();
@@ -512,6 +518,7 @@ void ChooseWeak(const std::vector<int>& order, const VerifiedPlaces& verified,
   const double ratio = static_cast<double>(second) / static_cast<double>(best->consensus);
   if (second > 0 && ratio >= config.ambiguity_ratio) return;
   match.weak = *best;
+  match.weak->verified = PassesSecondCheck(*best, min_gamma);  // at this threshold's gamma_min
   const double consensus_factor =
       std::min(1.0, static_cast<double>(best->consensus) / config.confidence_consensus);
   match.weak_confidence = consensus_factor * best->gamma * (1.0 - ratio);
@@ -605,7 +612,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   for (std::size_t k = 0; k < thresholds.size(); ++k) {
     GatherVerified(verification, orders[k], gamma_of(thresholds[k]), exclude, verified, matches[k]);
     ChooseAnswer(places_, config_, matches[k]);
-    ChooseWeak(orders[k], verified, config_, matches[k]);
+    ChooseWeak(orders[k], verified, gamma_of(thresholds[k]), config_, matches[k]);
   }
   const double seconds_verification = SecondsSince(verify_start);
   const double seconds = SecondsSince(start);

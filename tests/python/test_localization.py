@@ -64,13 +64,17 @@ class LocalizationTest(unittest.TestCase):
         self.assertEqual(got, expected)
 
     def test_weak_answers_come_only_with_answers_not_accepted(self):
+        weak_answers = 0
         for _, answer in self.answers:
             weak = answer.weak_T_world_odom
             if answer.found:
                 self.assertIsNone(weak)
             elif weak is not None:
+                weak_answers += 1
                 self.assertEqual(weak.shape, (3,))
                 self.assertTrue(np.all(np.isfinite(weak)))
+        # One of the 77 answers on these scans is not accepted but names a weak answer.
+        self.assertGreater(weak_answers, 0)
 
     def test_range_arrays_give_the_answers_of_scans(self):
         localizer = keyplace.GlobalLocalizer(keyplace.load_map(self.map_path))

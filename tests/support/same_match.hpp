@@ -53,6 +53,9 @@ inline void ExpectSameMatch(const PlaceMatch& a, const PlaceMatch& b, const std:
   EXPECT_EQ(a.candidates_verified, b.candidates_verified) << where;
   EXPECT_EQ(a.candidates_accepted, b.candidates_accepted) << where;
   EXPECT_EQ(a.places_excluded, b.places_excluded) << where;
+  EXPECT_EQ(a.weak_confidence, b.weak_confidence) << where;
+  ASSERT_EQ(a.weak.has_value(), b.weak.has_value()) << where;
+  if (a.weak) ExpectSameCandidate(*a.weak, *b.weak, where + ", weak answer");
   ASSERT_EQ(a.verified_candidates.size(), b.verified_candidates.size()) << where;
   for (std::size_t k = 0; k < a.verified_candidates.size(); ++k) {
     ExpectSameCandidate(a.verified_candidates[k], b.verified_candidates[k],

@@ -32,15 +32,16 @@ namespace keyplace {
 
 /// When the answers of the localizer make a fix, keep it, or lose it (Relocalizer).
 struct FixPolicy {
-  // Accepted answers that must agree through odometry before the first fix (1: every accepted
-  // answer is a fix).
+  // Answers that must agree through odometry before the first fix, one of them accepted (the
+  // others may be weak: LocalizationResult::weak_T_world_odom); 1: every accepted answer is a
+  // fix.
   int confirmations = 2;
   // Two answers agree when they put the robot now within agree_m + agree_per_m * (odometry
   // distance between them) and agree_deg of each other: the slack is odometry drift.
   double agree_m = 1.0;
   double agree_per_m = 0.02;
   double agree_deg = 10.0;
-  // Accepted answers older than this (odometry distance) are forgotten while searching.
+  // Answers older than this (odometry distance) are forgotten while searching.
   double window_m = 20.0;
   // A fix that no answer confirmed over this odometry distance is given up (lost).
   double lost_after_m = 20.0;

@@ -116,7 +116,7 @@ struct CandidateResult {
   // The dense check applied (enough of the query's endpoints in the candidate's area) and did not
   // veto the pose: the beams support it, whatever gamma says (PlaceMatch::weak).
   bool dense_supported = false;
-  bool verified = false;  // passed all checks
+  bool verified = false;  // passed all checks (within a sweep: at its lowest gamma_min)
   Pose2 T_ref_cur;
   Pose2 estimated_pose;  // Eq. (9)
   // Covariance of estimated_pose over its (x, y, theta) (world frame): RigidFitCovariance of the
