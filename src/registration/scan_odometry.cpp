@@ -13,6 +13,10 @@ namespace keyplace {
 namespace {
 
 constexpr double kMaxRecoveryPoses = 1e6;
+// Scans over which the odometry's total judges a catch-up: longer than its stalls (Intel raw:
+// 13 scans with no motion, then 0.77 m at once), short enough that its drift over them stays far
+// below the correction bound it decides (25 scans of 5 cm: 1.25 m, a few cm of drift).
+constexpr std::size_t kOdometryWindowScans = 25;
 
 void RequireOdometryField(bool condition, const char* field, const char* what) {
   if (!condition) {
@@ -188,10 +192,39 @@ bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
 // which (docs/REGISTRATION.md, "Odometry glitches").
 bool ScanOdometry::ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
                                                      const Pose2& icp_T_world_laser) const {
-  if (!have_previous_icp_step_) return false;
-  const Pose2 motion_T_world_laser = previous_T_world_laser_ * previous_step_laser_;
-  return !WithinCorrectionBounds(Between(motion_T_world_laser, predicted_T_world_laser)) &&
-         WithinCorrectionBounds(Between(motion_T_world_laser, icp_T_world_laser));
+  const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
+  if (!motion_T_world_laser) return false;
+  return !WithinCorrectionBounds(Between(*motion_T_world_laser, predicted_T_world_laser)) &&
+         WithinCorrectionBounds(Between(*motion_T_world_laser, icp_T_world_laser));
+}
+
+std::optional<Pose2> ScanOdometry::MotionPrediction() const {
+  if (!have_previous_icp_step_) return std::nullopt;
+  return previous_T_world_laser_ * previous_step_laser_;
+}
+
+std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
+    const std::vector<Eigen::Vector2d>& source, const IcpResult& from_odometry,
+    const Pose2& odometry_laser) const {
+  const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
+  if (!motion_T_world_laser || window_.empty()) return std::nullopt;
+  const IcpResult from_motion =
+      AlignPointToLine(*target_, source, *motion_T_world_laser, config_.icp);
+  if (!from_motion.converged ||
+      !WithinCorrectionBounds(Between(*motion_T_world_laser, from_motion.T_target_source))) {
+    return std::nullopt;
+  }
+  // Where the odometry's total since the oldest scan of the window puts this scan.
+  const Past& oldest = window_.front();
+  const Pose2 total_T_world_laser =
+      oldest.T_world_laser * Between(oldest.odometry_laser, odometry_laser);
+  const auto off_m = [&](const Pose2& T_world_laser) {
+    return TranslationNorm(Between(total_T_world_laser, T_world_laser));
+  };
+  if (off_m(from_motion.T_target_source) < off_m(from_odometry.T_target_source)) {
+    return from_motion;
+  }
+  return std::nullopt;
 }
 
 ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
@@ -205,10 +238,12 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
 
   // Odometry increment of the laser since the previous scan.
   Pose2 odometry_increment;  // identity without odometry
+  Pose2 odometry_laser;
   const bool increment_measured = T_odom_robot.has_value() && previous_scan_had_odometry_;
   previous_scan_had_odometry_ = T_odom_robot.has_value();
+  if (!increment_measured) window_.clear();  // no odometry total across a scan without it
   if (T_odom_robot) {
-    const Pose2 odometry_laser = *T_odom_robot * T_robot_laser;
+    odometry_laser = *T_odom_robot * T_robot_laser;
     if (have_previous_odometry_)
       odometry_increment = Between(previous_odometry_laser_, odometry_laser);
     previous_odometry_laser_ = odometry_laser;
@@ -246,6 +281,16 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       } else if (WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source))) {
         result.status = ScanOdometryStatus::kRegistered;
         T_world_laser = icp.T_target_source;
+        const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
+        if (config_.recovery_search && increment_measured && motion_T_world_laser &&
+            !WithinCorrectionBounds(Between(*motion_T_world_laser, predicted_T_world_laser))) {
+          if (const std::optional<IcpResult> better =
+                  MotionBetterByOdometryTotal(source, icp, odometry_laser)) {
+            RecordIcp(*better, &result);
+            result.status = ScanOdometryStatus::kRecovered;
+            T_world_laser = better->T_target_source;
+          }
+        }
       } else if (config_.recovery_search && increment_measured &&
                  ConstantVelocityOverrulesOdometry(predicted_T_world_laser, icp.T_target_source)) {
         result.status = ScanOdometryStatus::kRecovered;
@@ -282,6 +327,10 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     previous_step_laser_ = Between(previous_T_world_laser_, result.T_world_laser);
   }
   previous_T_world_laser_ = result.T_world_laser;
+  if (T_odom_robot) {
+    window_.push_back({result.T_world_laser, odometry_laser});
+    while (window_.size() > kOdometryWindowScans) window_.pop_front();
+  }
   ++num_scans_;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

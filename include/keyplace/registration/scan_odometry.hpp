@@ -140,6 +140,17 @@ class ScanOdometry {
   /// converged within those bounds of the constant-velocity one.
   bool ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
                                          const Pose2& icp_T_world_laser) const;
+  /// The previous ICP step repeated (constant velocity), when the last scan converged.
+  std::optional<Pose2> MotionPrediction() const;
+  /// ICP converged within the correction bounds of the odometry's prediction, which parts from
+  /// the constant-velocity one beyond them. When ICP from the latter converges within its bounds
+  /// too (the scan cannot tell the two apart: a corridor), returns that result if its motion over
+  /// the scans in `window_` agrees better with the odometry's total over them: a stale reading
+  /// that catches up is right in total, not in its last step (docs/REGISTRATION.md, "Odometry
+  /// that stalls, then catches up").
+  std::optional<IcpResult> MotionBetterByOdometryTotal(const std::vector<Eigen::Vector2d>& source,
+                                                       const IcpResult& from_odometry,
+                                                       const Pose2& odometry_laser) const;
 
   ScanOdometryConfig config_;
   std::size_t num_scans_ = 0;
@@ -152,6 +163,12 @@ class ScanOdometry {
   // that scan converged (a fallback's step is the odometry's own).
   Pose2 previous_step_laser_;
   bool have_previous_icp_step_ = false;
+  // The latest scans, each with odometry since the oldest: pose and odometry (laser frames).
+  struct Past {
+    Pose2 T_world_laser;
+    Pose2 odometry_laser;
+  };
+  std::deque<Past> window_;
   Pose2 last_keyframe_T_world_laser_;
   struct Keyframe {
     std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
