@@ -99,10 +99,20 @@ std::uint8_t DenseReference::FlagsAt(const Eigen::Vector2d& point_m) const {
                 static_cast<std::size_t>(i)];
 }
 
-bool DenseReference::Inside(const Eigen::Vector2d& point_m) const {
-  const double i = std::floor(point_m.x() / cell_size_m_);
-  const double j = std::floor(point_m.y() / cell_size_m_);
-  return i >= min_cell_.x() && i <= max_cell_.x() && j >= min_cell_.y() && j <= max_cell_.y();
+DenseReference::Probe DenseReference::ProbeAt(const Eigen::Vector2d& point_m) const {
+  const double cell_i = std::floor(point_m.x() / cell_size_m_);
+  const double cell_j = std::floor(point_m.y() / cell_size_m_);
+  Probe probe;
+  probe.inside = cell_i >= min_cell_.x() && cell_i <= max_cell_.x() && cell_j >= min_cell_.y() &&
+                 cell_j <= max_cell_.y();
+  if (!probe.inside) return probe;  // no caller reads the flags outside the box
+  const double i = cell_i - min_cell_.x() + margin_;
+  const double j = cell_j - min_cell_.y() + margin_;
+  if (i >= 0.0 && j >= 0.0 && i < width_ && j < height_) {
+    probe.flags = flags_[static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) +
+                         static_cast<std::size_t>(i)];
+  }
+  return probe;
 }
 
 // Samples the beam every half cell up to kDenseSeeThroughMarginM short of its endpoint. A beam
@@ -141,10 +151,10 @@ bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::V
   for (std::int64_t k = first; k <= last; ++k) {
     const double s = static_cast<double>(k) * step;
     if (s < 0.0 || s >= free_length) continue;
-    const Eigen::Vector2d point = origin_m + s * direction;
-    if (!Inside(point)) continue;
+    const Probe probe = ProbeAt(origin_m + s * direction);
+    if (!probe.inside) continue;
     crossed = true;
-    if (!(FlagsAt(point) & kOccupied)) continue;
+    if (!(probe.flags & kOccupied)) continue;
     const double beyond = s + kDenseWallCrossingM;
     if (beyond < free_length && !(FlagsAt(origin_m + beyond * direction) & kNearOccupied)) {
       return true;
@@ -163,9 +173,10 @@ DenseScore DenseReference::Score(const Pose2& T_ref_query,
     const Eigen::Vector2d origin = T_ref_query * scan.origin_m;
     for (const Eigen::Vector2d& endpoint_query : scan.endpoints_m) {
       const Eigen::Vector2d endpoint = T_ref_query * endpoint_query;
-      if (Inside(endpoint)) {
+      const Probe probe = ProbeAt(endpoint);
+      if (probe.inside) {
         ++score.endpoints;
-        if (FlagsAt(endpoint) & kNearOccupied) ++hits;
+        if (probe.flags & kNearOccupied) ++hits;
       }
       bool crossed = false;
       if (SeesThrough(origin, endpoint, crossed)) ++seen_through;
@@ -186,10 +197,10 @@ DenseScore DenseReference::Hits(const Pose2& T_ref_query, const std::vector<Quer
   int hits = 0;
   for (const QueryScanPoints& scan : scans) {
     for (std::size_t k = 0; k < scan.endpoints_m.size(); k += stride) {
-      const Eigen::Vector2d endpoint = to_ref(scan.endpoints_m[k]);
-      if (!Inside(endpoint)) continue;
+      const Probe probe = ProbeAt(to_ref(scan.endpoints_m[k]));
+      if (!probe.inside) continue;
       ++score.endpoints;
-      if (FlagsAt(endpoint) & kNearOccupied) ++hits;
+      if (probe.flags & kNearOccupied) ++hits;
     }
   }
   if (score.endpoints > 0) score.hit_fraction = static_cast<double>(hits) / score.endpoints;

@@ -108,19 +108,29 @@ Eigen::Matrix3d ComposedCovariance(const Pose2& T_a_b, const Pose2& T_b_c, const
 
 namespace {
 
-// ScoreTransform against reference keypoints already sorted for the inlier search.
+// How many keypoints RANSAC scores between two looks at whether a hypothesis can still win.
+constexpr std::size_t kBeatCheckEvery = 8;
+
+// ScoreTransform against reference keypoints already sorted for the inlier search. When the
+// score cannot come below `to_beat` it returns +infinity early: the terms are never negative, so
+// the partial sum, divided as the whole, only grows (rounding is monotone too).
 double ScoreAgainst(const NearestReference& reference, const std::vector<Eigen::Vector2d>& current,
-                    const Pose2& T_ref_cur, std::vector<std::pair<int, int>>* inliers) {
+                    const Pose2& T_ref_cur, std::vector<std::pair<int, int>>* inliers,
+                    double to_beat = std::numeric_limits<double>::infinity()) {
   if (inliers) inliers->clear();
   if (current.empty()) return 0.0;
+  const auto n = static_cast<double>(current.size());
   double score = 0.0;
   const PointMapper ref_from_cur(T_ref_cur);
   for (std::size_t i = 0; i < current.size(); ++i) {
     const auto [nearest, distance2] = reference.Nearest(ref_from_cur(current[i]));
     if (nearest >= 0 && inliers) inliers->emplace_back(static_cast<int>(i), nearest);
     score += distance2;  // the threshold^2 when there is no inlier: the truncated (MSAC) cost
+    if ((i + 1) % kBeatCheckEvery == 0 && score / n >= to_beat) {
+      return std::numeric_limits<double>::infinity();
+    }
   }
-  return score / static_cast<double>(current.size());
+  return score / n;
 }
 
 }  // namespace
@@ -153,7 +163,8 @@ RansacResult EstimateRigidTransformRansac(const std::vector<Eigen::Vector2d>& re
     if ((d_cur - d_ref) * (d_cur - d_ref) / (8.0 * (d_cur + d_ref)) > config.rigidity_m2) return;
     const Pose2 hypothesis = HypothesisFromTwoPairs(c1, c2, r1, r2);
     ++result.hypotheses;
-    const double score = ScoreAgainst(nearest_reference, current, hypothesis, &inliers);
+    const double score =
+        ScoreAgainst(nearest_reference, current, hypothesis, &inliers, result.score);
     if (score < result.score) {
       result.score = score;
       result.T_ref_cur = hypothesis;
