@@ -250,6 +250,12 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
     const auto begin = static_cast<std::size_t>(first_of_place_[first_place]);
     const auto count = static_cast<std::size_t>(first_of_place_[end_place]) - begin;
     if (count == 0) return;
+    // A block none of whose places is searched (retrieval narrowed them) costs no product.
+    if (std::none_of(searched.begin() + static_cast<std::ptrdiff_t>(first_place),
+                     searched.begin() + static_cast<std::ptrdiff_t>(end_place),
+                     [](char s) { return s != 0; })) {
+      return;
+    }
     Eigen::MatrixXd dots(static_cast<Eigen::Index>(count),
                          static_cast<Eigen::Index>(query.size()));  // keypoint x query row
     dots.noalias() =

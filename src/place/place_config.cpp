@@ -65,6 +65,11 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
                {C::DescriptorIndex::kDense, "dense"}},
               "how descriptor pairs are found (same pairs): exhaustive chi2 (none), or a "
               "square-root bound searched by a kd-tree (kdtree) or a matrix product (dense)")
+        .Enum("retrieval", &C::retrieval,
+              {{C::Retrieval::kExact, "exact"}, {C::Retrieval::kWords, "words"}},
+              "places paired with a query: every one (exact), or the retrieval_places most "
+              "similar by a vocabulary of descriptors learned from the map (words)")
+        .Int("retrieval_places", &C::retrieval_places, "", "words: places paired with a query")
         .Enum("query_keypoints", &C::query_keypoints,
               {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}},
               "query keypoints paired and verified: the submap's stable ones or all its scans'")
@@ -158,6 +163,7 @@ void Validate(const PlaceRecognitionConfig& config) {
   Require(config.max_candidates >= 1, "max_candidates", "must be >= 1");
   Require(config.descriptor_match_chi2 > 0.0, "descriptor_match_chi2", "must be positive");
   Require(config.query_merge_m >= 0.0, "query_merge_m", "must be >= 0");
+  Require(config.retrieval_places >= 1, "retrieval_places", "must be >= 1");
   Require(config.ransac.inlier_distance_m > 0.0, "ransac.inlier_distance_m", "must be positive");
   Require(config.ransac.iterations >= 1, "ransac.iterations", "must be >= 1");
   Require(config.ransac.exhaustive_max_pairs >= 0, "ransac.exhaustive_max_pairs", "must be >= 0");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "place/descriptor_index.hpp"
+#include "place/place_words.hpp"
 #include "place/unique_pairs.hpp"
 
 namespace keyplace {
@@ -266,9 +267,17 @@ PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecogniti
     }
   }
   RebuildIndex();
+  RebuildWords();
 }
 
 PlaceRecognizer::~PlaceRecognizer() = default;
+
+void PlaceRecognizer::RebuildWords() {
+  words_.reset();
+  if (config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
+    words_ = std::make_shared<const PlaceWords>(places_);
+  }
+}
 
 void PlaceRecognizer::RebuildIndex() {
   index_.reset();
@@ -285,6 +294,7 @@ void PlaceRecognizer::AddPlace(Place place) {
                                 ": positions and descriptors differ in size");
   }
   places_.push_back(std::move(place));
+  RebuildWords();
   if (!index_) return;  // kNone
   if (index_.use_count() > 1) {
     RebuildIndex();  // a copy shares the index: never change it under the copy
@@ -300,6 +310,7 @@ bool PlaceRecognizer::RemovePlace(int place_id) {
   const auto p = static_cast<std::size_t>(it - places_.begin());
   removed_keypoints_ += it->descriptors.size();
   places_.erase(it);
+  RebuildWords();
   if (!index_) return true;  // kNone
   slots_.erase(slots_.begin() + static_cast<std::ptrdiff_t>(p));
   // The removed keypoints stay indexed (never searched: Recognize searches the slots of places_)

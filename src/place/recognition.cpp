@@ -25,6 +25,7 @@
 #include "keyplace/place/ransac.hpp"
 #include "place/candidate_ranking.hpp"
 #include "place/descriptor_index.hpp"
+#include "place/place_words.hpp"
 #include "place/unique_pairs.hpp"
 
 namespace keyplace {
@@ -98,10 +99,27 @@ struct Pairing {
   std::vector<char> excluded;       // places of >= min_pairs keypoints that `exclude` rejected
 };
 
+// Of the places marked in `searched`, keeps the `count` most similar to the query by their words
+// (ties: the earlier place).
+void KeepRetrieved(const PlaceWords& words, const std::vector<BetaGridDescriptor>& query,
+                   std::size_t count, std::vector<char>& searched) {
+  const std::vector<double> similarity = words.Similarities(query);
+  std::vector<int> order;
+  for (std::size_t p = 0; p < searched.size(); ++p) {
+    if (searched[p]) order.push_back(static_cast<int>(p));
+  }
+  if (order.size() <= count) return;
+  std::stable_sort(order.begin(), order.end(), [&similarity](int a, int b) {
+    return similarity[static_cast<std::size_t>(a)] > similarity[static_cast<std::size_t>(b)];
+  });
+  for (std::size_t k = count; k < order.size(); ++k)
+    searched[static_cast<std::size_t>(order[k])] = 0;
+}
+
 Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorIndex* index,
                        const std::vector<std::size_t>& slots, const PlaceRecognitionConfig& config,
                        const std::vector<BetaGridDescriptor>& query, std::size_t min_pairs,
-                       const PlaceExclusion& exclude) {
+                       const PlaceExclusion& exclude, const PlaceWords* words) {
   Pairing pairing;
   pairing.by_place.resize(places.size());
   pairing.excluded.assign(places.size(), 0);
@@ -113,6 +131,9 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
       continue;
     }
     searched[p] = 1;
+  }
+  if (words) {
+    KeepRetrieved(*words, query, static_cast<std::size_t>(config.retrieval_places), searched);
   }
   // The index finds, per place, the pairs below the threshold that the exhaustive loop of
   // MatchDescriptorPairs finds, in its order and with its distances.
@@ -575,7 +596,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   Pairing pairing;
   if (keypoints.positions.size() >= lowest_pairs) {
     pairing = PairWithPlaces(places_, index_.get(), slots_, config_, keypoints.descriptors,
-                             lowest_pairs, exclude);
+                             lowest_pairs, exclude, words_.get());
   }
   std::vector<int> rigid_star(places_.size(), -1);
   std::vector<std::vector<int>> orders(thresholds.size());

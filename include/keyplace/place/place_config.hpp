@@ -37,6 +37,12 @@ struct PlaceRecognitionConfig {
   // matrix product of the query keypoints with all place keypoints.
   enum class DescriptorIndex { kNone, kKdTree, kDense };
   DescriptorIndex descriptor_index = DescriptorIndex::kDense;
+  // Which places a query is paired with. kExact: every place (the oracle). kWords: the
+  // retrieval_places places whose word histograms (a vocabulary of descriptors learned from the
+  // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval").
+  enum class Retrieval { kExact, kWords };
+  Retrieval retrieval = Retrieval::kExact;
+  int retrieval_places = 50;
   // Which query keypoints go through pairing and RANSAC. kStable: the query submap's stable
   // keypoints (the paper). kAllScans: every keypoint of every scan of the query submap, in the
   // submap frame (PlaceQuery::all_positions), merged within query_merge_m; falls back to the

@@ -183,6 +183,7 @@ struct RecognitionThresholds {
 };
 
 class SqrtDescriptorIndex;  // place/descriptor_index.hpp (internal)
+class PlaceWords;           // place/place_words.hpp (internal)
 
 class PlaceRecognizer {
  public:
@@ -236,12 +237,15 @@ class PlaceRecognizer {
  private:
   // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for kNone.
   void RebuildIndex();
+  // The vocabulary and word histograms of places_ (retrieval kWords), learned anew.
+  void RebuildWords();
 
   std::vector<Place> places_;
   PlaceRecognitionConfig config_;
   std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none
   std::vector<std::size_t> slots_;              // index place number of each of places_
   std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
+  std::shared_ptr<const PlaceWords> words_;     // null for retrieval exact
 };
 
 }  // namespace keyplace
