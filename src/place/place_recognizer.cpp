@@ -273,9 +273,8 @@ PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecogniti
 PlaceRecognizer::~PlaceRecognizer() = default;
 
 void PlaceRecognizer::RebuildWords() {
-  words_.reset();
   if (config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
-    words_ = std::make_shared<const PlaceWords>(places_);
+    words_ = std::make_shared<const PlaceWords>(places_);  // built first: a throw keeps the old
   }
 }
 

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <cstddef>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -13,8 +14,10 @@ using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 
 // Descriptors the vocabulary is learned from at most (evenly spaced over the map): k-means then
 // costs the same for any larger map.
-constexpr std::size_t kMaxSamples = 20000;
-constexpr int kIterations = 8;
+constexpr std::size_t kMaxVocabularySamples = 20000;
+// Lloyd iterations: the vocabulary only needs to spread its words over the descriptors, not
+// converge.
+constexpr int kKMeansIterations = 8;
 
 // One word per 8 map keypoints: on FR079 and Intel (about 4 300 and 4 900 keypoints) 512 words
 // kept more right answers of true revisits than 64, 256 or 1024.
@@ -34,7 +37,7 @@ void FillRoots(const BetaGridDescriptor& descriptor, float* row) {
 std::vector<int> Assign(const RowMatrixF& samples, const RowMatrixF& centres) {
   const Eigen::VectorXf centre_norms = centres.rowwise().squaredNorm();
   std::vector<int> word(static_cast<std::size_t>(samples.rows()), 0);
-  constexpr Eigen::Index kBlock = 2048;
+  constexpr Eigen::Index kBlock = 2048;  // rows per product: 2048 x words floats at most
   for (Eigen::Index begin = 0; begin < samples.rows(); begin += kBlock) {
     const Eigen::Index count = std::min(kBlock, samples.rows() - begin);
     const Eigen::MatrixXf dots = samples.middleRows(begin, count) * centres.transpose();
@@ -49,12 +52,12 @@ std::vector<int> Assign(const RowMatrixF& samples, const RowMatrixF& centres) {
 
 }  // namespace
 
-PlaceWords::PlaceWords(const std::vector<Place>& places) : places_(places.size()) {
+PlaceWords::PlaceWords(const std::vector<Place>& places) : num_places_(places.size()) {
   std::size_t keypoints = 0;
   for (const Place& place : places) keypoints += place.descriptors.size();
   if (keypoints == 0) return;
   const std::size_t n_words = std::min(WordCount(keypoints), keypoints);
-  const std::size_t stride = (keypoints + kMaxSamples - 1) / kMaxSamples;
+  const std::size_t stride = (keypoints + kMaxVocabularySamples - 1) / kMaxVocabularySamples;
   RowMatrixF samples(static_cast<Eigen::Index>((keypoints + stride - 1) / stride), kBetaGridBins);
   std::size_t k = 0;
   Eigen::Index row = 0;
@@ -69,7 +72,7 @@ PlaceWords::PlaceWords(const std::vector<Place>& places) : places_(places.size()
     centres.row(static_cast<Eigen::Index>(w)) = samples.row(
         static_cast<Eigen::Index>(w * static_cast<std::size_t>(samples.rows()) / n_words));
   }
-  for (int iteration = 0; iteration < kIterations; ++iteration) {
+  for (int iteration = 0; iteration < kKMeansIterations; ++iteration) {
     const std::vector<int> word = Assign(samples, centres);
     RowMatrixF sums = RowMatrixF::Zero(centres.rows(), kBetaGridBins);
     std::vector<int> counts(n_words, 0);
@@ -84,26 +87,18 @@ PlaceWords::PlaceWords(const std::vector<Place>& places) : places_(places.size()
       }
     }
   }
-  centres_.assign(centres.data(), centres.data() + centres.size());
-  centre_norms_.resize(n_words);
-  for (std::size_t w = 0; w < n_words; ++w) {
-    centre_norms_[w] = centres.row(static_cast<Eigen::Index>(w)).squaredNorm();
-  }
+  centres_ = std::move(centres);
 
   // Word counts per place, then tf-idf weights normalised per place.
   std::vector<std::vector<std::pair<int, int>>> counts_of_place(places.size());
   std::vector<int> places_with_word(n_words, 0);
   std::vector<std::vector<int>> own_words(places.size());
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    for (const BetaGridDescriptor& descriptor : places[p].descriptors) {
-      own_words[p].push_back(WordOf(descriptor));
-    }
-  }
+  for (std::size_t p = 0; p < places.size(); ++p) own_words[p] = WordsOf(places[p].descriptors);
   for (std::size_t p = 0; p < places.size(); ++p) {
     std::vector<int> count(n_words, 0);
     for (int offset = -kNeighbours; offset <= kNeighbours; ++offset) {
-      const long q = static_cast<long>(p) + offset;
-      if (q < 0 || q >= static_cast<long>(places.size())) continue;
+      const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + offset;
+      if (q < 0 || q >= static_cast<std::ptrdiff_t>(places.size())) continue;
       if (places[static_cast<std::size_t>(q)].id != places[p].id + offset) continue;
       for (const int w : own_words[static_cast<std::size_t>(q)])
         ++count[static_cast<std::size_t>(w)];
@@ -136,29 +131,20 @@ PlaceWords::PlaceWords(const std::vector<Place>& places) : places_(places.size()
   }
 }
 
-int PlaceWords::WordOf(const BetaGridDescriptor& descriptor) const {
-  float root[kBetaGridBins];
-  FillRoots(descriptor, root);
-  int best = 0;
-  float best_distance = std::numeric_limits<float>::infinity();
-  for (std::size_t w = 0; w < centre_norms_.size(); ++w) {
-    const float* centre = centres_.data() + w * kBetaGridBins;
-    float dot = 0.0F;
-    for (int i = 0; i < kBetaGridBins; ++i) dot += root[i] * centre[i];
-    const float distance = centre_norms_[w] - 2.0F * dot;
-    if (distance < best_distance) {
-      best_distance = distance;
-      best = static_cast<int>(w);
-    }
+std::vector<int> PlaceWords::WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const {
+  if (descriptors.empty()) return {};
+  RowMatrixF roots(static_cast<Eigen::Index>(descriptors.size()), kBetaGridBins);
+  for (std::size_t k = 0; k < descriptors.size(); ++k) {
+    FillRoots(descriptors[k], roots.row(static_cast<Eigen::Index>(k)).data());
   }
-  return best;
+  return Assign(roots, centres_);
 }
 
 std::vector<double> PlaceWords::Similarities(const std::vector<BetaGridDescriptor>& query) const {
-  std::vector<double> similarity(places_, 0.0);
+  std::vector<double> similarity(num_places_, 0.0);
   if (idf_.empty() || query.empty()) return similarity;
   std::vector<int> count(idf_.size(), 0);
-  for (const BetaGridDescriptor& descriptor : query) ++count[WordOf(descriptor)];
+  for (const int word : WordsOf(query)) ++count[static_cast<std::size_t>(word)];
   double norm2 = 0.0;
   for (std::size_t w = 0; w < count.size(); ++w) {
     const double weight = count[w] * idf_[w];

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "keyplace/features/descriptor.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 
@@ -17,7 +19,8 @@ namespace keyplace {
 
 class PlaceWords {
  public:
-  /// Learns the vocabulary from the places' descriptors (deterministic) and indexes each place.
+  /// Learns the vocabulary from the places' descriptors (deterministic) and indexes each place:
+  /// O(keypoints x words), which a recognizer that relearns it on every AddPlace pays per place.
   explicit PlaceWords(const std::vector<Place>& places);
 
   /// The cosine similarity of the query's tf-idf word histogram with each place's, in the order
@@ -27,14 +30,13 @@ class PlaceWords {
   std::size_t words() const { return idf_.size(); }
 
  private:
-  // The word of one descriptor: its nearest centre in square-root space.
-  int WordOf(const BetaGridDescriptor& descriptor) const;
+  // The word of each descriptor: its nearest centre in square-root space.
+  std::vector<int> WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const;
 
-  std::vector<float> centres_;       // words() rows of kBetaGridBins square roots
-  std::vector<float> centre_norms_;  // squared norms of the rows
-  std::vector<double> idf_;          // log(places / places holding the word)
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> centres_;  // a word a row
+  std::vector<double> idf_;  // log(places / places holding the word)
   std::vector<std::vector<std::pair<int, double>>> postings_;  // per word: (place, weight)
-  std::size_t places_ = 0;
+  std::size_t num_places_ = 0;
 };
 
 }  // namespace keyplace

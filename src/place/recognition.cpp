@@ -124,8 +124,11 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
   pairing.by_place.resize(places.size());
   pairing.excluded.assign(places.size(), 0);
   std::vector<char> searched(places.size(), 0);
+  // Retrieval ranks every place `exclude` lets through, whatever mu: RecognizeAtThresholds pairs
+  // once for all its thresholds, so the places retrieved must not depend on mu.
+  const auto too_small = [&](std::size_t p) { return places[p].positions.size() < min_pairs; };
   for (std::size_t p = 0; p < places.size(); ++p) {
-    if (places[p].positions.size() < min_pairs) continue;  // can never reach mu pairs
+    if (!words && too_small(p)) continue;  // can never reach mu pairs
     if (exclude && exclude(places[p])) {
       pairing.excluded[p] = 1;
       continue;
@@ -134,6 +137,7 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
   }
   if (words) {
     KeepRetrieved(*words, query, static_cast<std::size_t>(config.retrieval_places), searched);
+    for (std::size_t p = 0; p < places.size(); ++p) searched[p] = searched[p] && !too_small(p);
   }
   // The index finds, per place, the pairs below the threshold that the exhaustive loop of
   // MatchDescriptorPairs finds, in its order and with its distances.

@@ -207,17 +207,19 @@ std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
     const std::vector<Eigen::Vector2d>& source, const IcpResult& from_odometry,
     const Pose2& odometry_laser) const {
   const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
-  if (!motion_T_world_laser || window_.empty()) return std::nullopt;
+  if (!motion_T_world_laser || odometry_window_.size() < kOdometryWindowScans) return std::nullopt;
   const IcpResult from_motion =
       AlignPointToLine(*target_, source, *motion_T_world_laser, config_.icp);
+  // Two minima, each near its start: anything less is one pose found twice.
   if (!from_motion.converged ||
-      !WithinCorrectionBounds(Between(*motion_T_world_laser, from_motion.T_target_source))) {
+      !WithinCorrectionBounds(Between(*motion_T_world_laser, from_motion.T_target_source)) ||
+      WithinCorrectionBounds(Between(from_odometry.T_target_source, from_motion.T_target_source))) {
     return std::nullopt;
   }
   // Where the odometry's total since the oldest scan of the window puts this scan.
-  const Past& oldest = window_.front();
+  const Past& oldest = odometry_window_.front();
   const Pose2 total_T_world_laser =
-      oldest.T_world_laser * Between(oldest.odometry_laser, odometry_laser);
+      oldest.T_world_laser * Between(oldest.T_odom_laser, odometry_laser);
   const auto off_m = [&](const Pose2& T_world_laser) {
     return TranslationNorm(Between(total_T_world_laser, T_world_laser));
   };
@@ -241,7 +243,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
   Pose2 odometry_laser;
   const bool increment_measured = T_odom_robot.has_value() && previous_scan_had_odometry_;
   previous_scan_had_odometry_ = T_odom_robot.has_value();
-  if (!increment_measured) window_.clear();  // no odometry total across a scan without it
+  if (!increment_measured) odometry_window_.clear();  // no odometry total across a scan without it
   if (T_odom_robot) {
     odometry_laser = *T_odom_robot * T_robot_laser;
     if (have_previous_odometry_)
@@ -328,8 +330,8 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
   }
   previous_T_world_laser_ = result.T_world_laser;
   if (T_odom_robot) {
-    window_.push_back({result.T_world_laser, odometry_laser});
-    while (window_.size() > kOdometryWindowScans) window_.pop_front();
+    odometry_window_.push_back({result.T_world_laser, odometry_laser});
+    while (odometry_window_.size() > kOdometryWindowScans) odometry_window_.pop_front();
   }
   ++num_scans_;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

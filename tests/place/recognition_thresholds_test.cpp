@@ -58,6 +58,10 @@ std::vector<Setting> Settings() {
   first.selection = Config::Selection::kFirstVerified;
   first.max_candidates = 40;
   settings.push_back({"first verified, all-scan keypoints, 40 ranked", first});
+  Config retrieved = PlacePreset("default");
+  retrieved.retrieval = Config::Retrieval::kWords;
+  retrieved.retrieval_places = 20;  // fewer than the places of any mu: retrieval chooses
+  settings.push_back({"default, 20 places retrieved by words", retrieved});
   return settings;
 }
 

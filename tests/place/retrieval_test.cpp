@@ -5,7 +5,6 @@
 
 #include "place/place_words.hpp"
 
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,7 +34,9 @@ TEST(PlaceWords, APlaceIsTheMostSimilarToTheDescriptorsOfItsNeighbourhood) {
   const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
   ASSERT_GT(places.size(), 30u);
   const PlaceWords words(places);
-  EXPECT_GE(words.words(), 16u);
+  std::size_t keypoints = 0;
+  for (const Place& place : places) keypoints += place.descriptors.size();
+  EXPECT_EQ(words.words(), keypoints / 8);  // one word per 8 keypoints
   int checked = 0;
   for (std::size_t p = 2; p + 2 < places.size(); ++p) {
     if (places[p + 2].id != places[p - 2].id + 4) continue;  // not five adjacent submaps
@@ -84,6 +85,21 @@ TEST(Retrieval, WordsKeepTheRightAnswersOfTheBundledLogAndPairFewPlaces) {
   // retrieved, cannot make it ambiguous. Places drawn at random would keep about a fifth.
   EXPECT_GE(words_correct, exact_correct - 3);
   EXPECT_LE(words_wrong, exact_wrong + 1);
+}
+
+// Retrieving every place is the exact path: the same answers, field for field.
+TEST(Retrieval, RetrievingEveryPlaceIsTheExactPath) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
+  const std::vector<LocalizationRecord> exact = EvaluateQueries(
+      queries, PlaceRecognizer(places, PlaceRecognitionConfig{}), SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> words = EvaluateQueries(
+      queries, PlaceRecognizer(places, WordsConfig(static_cast<int>(places.size()))),
+      SelfMatchRule::kSameScans);
+  ASSERT_EQ(words.size(), exact.size());
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    testing::ExpectSameMatch(words[i].match, exact[i].match, "query " + std::to_string(i));
+  }
 }
 
 TEST(Retrieval, ChangedPlaceByPlaceItRetrievesAsOneBuiltAtOnce) {

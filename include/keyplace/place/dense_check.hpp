@@ -86,8 +86,9 @@ class DenseReference {
  private:
   // Bit 0: occupied; bit 1: within kDenseHitDistanceM of an occupied cell.
   std::uint8_t FlagsAt(const Eigen::Vector2d& point_m) const;
-  // Whether the point's cell lies in the box of the occupied cells, and its flags (FlagsAt):
-  // one cell computation for both (the beams' samples ask both, millions of times per query).
+  // Whether the point's cell lies in the box of the occupied cells and, only then, its flags
+  // (FlagsAt; 0 outside the box, where FlagsAt may still see the margin): one cell computation
+  // for both (the beams' samples ask both, millions of times per query).
   struct Probe {
     bool inside = false;
     std::uint8_t flags = 0;

@@ -197,8 +197,9 @@ class PlaceRecognizer {
   ~PlaceRecognizer();
 
   /// Appends a place (last in places()) and indexes its descriptors without rebuilding the index:
-  /// every answer is then the one of a recognizer constructed from places() at once. Throws
-  /// std::invalid_argument when its positions and descriptors differ in size.
+  /// every answer is then the one of a recognizer constructed from places() at once. With
+  /// retrieval kWords the vocabulary is learned anew from places() (O(map keypoints x words)).
+  /// Throws std::invalid_argument when its positions and descriptors differ in size.
   void AddPlace(Place place);
   /// Removes the first place with this id (later places move up one index); every answer is then
   /// the one of a recognizer constructed from the remaining places() at once. The index forgets

@@ -59,7 +59,10 @@ struct ScanOdometryConfig {
   // scan falls back to odometry as before. Before the search, an ICP result beyond the bounds is
   // taken (kRecovered) when the odometry's prediction and the previous ICP step repeated part by
   // more than the bounds and the result lies within them of the latter: the odometry glitched
-  // (only with odometry at this scan and the one before).
+  // (only with odometry at this scan and the one before). When the two predictions part so but
+  // ICP converged within the bounds of the odometry's, ICP also runs from the previous step
+  // repeated, and a result of it more than the bounds away is taken (kRecovered) when the
+  // odometry's total over the last scans agrees better with it: a stale reading caught up.
   // false: fall back at once.
   bool recovery_search = true;
   double recovery_window_translation_m = 0.5;
@@ -75,7 +78,8 @@ enum class ScanOdometryStatus {
   kFirstScan,   // defines the world frame (= odometry frame at the first scan)
   kRegistered,  // ICP converged and was accepted
   // ICP failed from the prediction and converged from a searched pose, or converged beyond the
-  // bounds where the previous step repeated says that the odometry glitched
+  // bounds where the previous step repeated says that the odometry glitched, or converged from
+  // the previous step repeated where the odometry's total says its last step caught up
   kRecovered,
   kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
   kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
@@ -145,7 +149,9 @@ class ScanOdometry {
   /// ICP converged within the correction bounds of the odometry's prediction, which parts from
   /// the constant-velocity one beyond them. When ICP from the latter converges within its bounds
   /// too (the scan cannot tell the two apart: a corridor), returns that result if its motion over
-  /// the scans in `window_` agrees better with the odometry's total over them: a stale reading
+  /// the scans in `odometry_window_` agrees better with the odometry's total over them (its
+  /// translation: a stalled reading's error is where the robot is, not how it is turned), a
+  /// result more than the correction bounds from the first and with a full window: a stale reading
   /// that catches up is right in total, not in its last step (docs/REGISTRATION.md, "Odometry
   /// that stalls, then catches up").
   std::optional<IcpResult> MotionBetterByOdometryTotal(const std::vector<Eigen::Vector2d>& source,
@@ -166,9 +172,9 @@ class ScanOdometry {
   // The latest scans, each with odometry since the oldest: pose and odometry (laser frames).
   struct Past {
     Pose2 T_world_laser;
-    Pose2 odometry_laser;
+    Pose2 T_odom_laser;
   };
-  std::deque<Past> window_;
+  std::deque<Past> odometry_window_;
   Pose2 last_keyframe_T_world_laser_;
   struct Keyframe {
     std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
