@@ -188,31 +188,30 @@ bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
 
 // Two independent predictions of this scan's pose: the odometry's, and the previous step as ICP
 // estimated it, repeated. When they part by more than the correction bound, one of them is wrong,
-// and ICP, which started from the odometry's and converged within the bound of the other, says
-// which (docs/REGISTRATION.md, "Odometry glitches").
-bool ScanOdometry::ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
-                                                     const Pose2& icp_T_world_laser) const {
-  const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
-  if (!motion_T_world_laser) return false;
-  return !WithinCorrectionBounds(Between(*motion_T_world_laser, predicted_T_world_laser)) &&
-         WithinCorrectionBounds(Between(*motion_T_world_laser, icp_T_world_laser));
-}
-
-std::optional<Pose2> ScanOdometry::MotionPrediction() const {
-  if (!have_previous_icp_step_) return std::nullopt;
-  return previous_T_world_laser_ * previous_step_laser_;
+// and ICP says which (docs/REGISTRATION.md, "Odometry glitches" and "Odometry that stalls, then
+// catches up"). Only with recovery on, odometry at this scan and the one before, and a previous
+// step ICP estimated.
+std::optional<Pose2> ScanOdometry::DisputingMotion(const Pose2& predicted_T_world_laser,
+                                                   bool increment_measured) const {
+  if (!config_.recovery_search || !increment_measured || !have_previous_icp_step_) {
+    return std::nullopt;
+  }
+  const Pose2 motion_T_world_laser = previous_T_world_laser_ * previous_step_laser_;
+  if (WithinCorrectionBounds(Between(motion_T_world_laser, predicted_T_world_laser))) {
+    return std::nullopt;
+  }
+  return motion_T_world_laser;
 }
 
 std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
-    const std::vector<Eigen::Vector2d>& source, const IcpResult& from_odometry,
-    const Pose2& odometry_laser) const {
-  const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
-  if (!motion_T_world_laser || odometry_window_.size() < kOdometryWindowScans) return std::nullopt;
+    const std::vector<Eigen::Vector2d>& source, const Pose2& motion_T_world_laser,
+    const IcpResult& from_odometry, const Pose2& odometry_laser) const {
+  if (odometry_window_.size() < kOdometryWindowScans) return std::nullopt;
   const IcpResult from_motion =
-      AlignPointToLine(*target_, source, *motion_T_world_laser, config_.icp);
+      AlignPointToLine(*target_, source, motion_T_world_laser, config_.icp);
   // Two minima, each near its start: anything less is one pose found twice.
   if (!from_motion.converged ||
-      !WithinCorrectionBounds(Between(*motion_T_world_laser, from_motion.T_target_source)) ||
+      !WithinCorrectionBounds(Between(motion_T_world_laser, from_motion.T_target_source)) ||
       WithinCorrectionBounds(Between(from_odometry.T_target_source, from_motion.T_target_source))) {
     return std::nullopt;
   }
@@ -227,6 +226,54 @@ std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
     return from_motion;
   }
   return std::nullopt;
+}
+
+// ICP from the prediction, the checks of its result and the recovery: the scan's pose, and its
+// status and ICP figures in `result` (the prediction itself when the scan falls back).
+Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
+                             const Pose2& predicted_T_world_laser,
+                             const std::optional<Pose2>& disputing_motion,
+                             const Pose2& odometry_laser, ScanOdometryResult& result) const {
+  Pose2 T_world_laser = predicted_T_world_laser;
+  const std::vector<Eigen::Vector2d> source =
+      SubsampleBySpacing(points, config_.source_min_spacing_m);
+  const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
+  RecordIcp(icp, &result);
+  if (!icp.converged) {
+    result.status = icp.status == IcpStatus::kTooFewPoints
+                        ? ScanOdometryStatus::kFallbackTooFewPoints
+                        : ScanOdometryStatus::kFallbackNotConverged;
+  } else if (WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source))) {
+    result.status = ScanOdometryStatus::kRegistered;
+    T_world_laser = icp.T_target_source;
+    const std::optional<IcpResult> better =
+        disputing_motion
+            ? MotionBetterByOdometryTotal(source, *disputing_motion, icp, odometry_laser)
+            : std::nullopt;
+    if (better) {
+      RecordIcp(*better, &result);
+      result.status = ScanOdometryStatus::kRecovered;
+      T_world_laser = better->T_target_source;
+    }
+  } else if (disputing_motion &&
+             WithinCorrectionBounds(Between(*disputing_motion, icp.T_target_source))) {
+    // ICP converged beyond the bound of the odometry's prediction, within that of the
+    // motion's: the odometry glitched.
+    result.status = ScanOdometryStatus::kRecovered;
+    T_world_laser = icp.T_target_source;
+  } else {
+    result.status = ScanOdometryStatus::kFallbackCorrectionTooLarge;
+  }
+  if (config_.recovery_search &&
+      (result.status == ScanOdometryStatus::kFallbackNotConverged ||
+       result.status == ScanOdometryStatus::kFallbackCorrectionTooLarge)) {
+    if (const std::optional<IcpResult> recovered = Recover(source, predicted_T_world_laser)) {
+      RecordIcp(*recovered, &result);
+      result.status = ScanOdometryStatus::kRecovered;
+      T_world_laser = recovered->T_target_source;
+    }
+  }
+  return T_world_laser;
 }
 
 ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
@@ -271,44 +318,9 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       result.status = ScanOdometryStatus::kFallbackTooFewPoints;
       result.icp_status = IcpStatus::kTooFewPoints;
     } else {
-      const std::vector<Eigen::Vector2d> source =
-          SubsampleBySpacing(points, config_.source_min_spacing_m);
-      const IcpResult icp =
-          AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
-      RecordIcp(icp, &result);
-      if (!icp.converged) {
-        result.status = icp.status == IcpStatus::kTooFewPoints
-                            ? ScanOdometryStatus::kFallbackTooFewPoints
-                            : ScanOdometryStatus::kFallbackNotConverged;
-      } else if (WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source))) {
-        result.status = ScanOdometryStatus::kRegistered;
-        T_world_laser = icp.T_target_source;
-        const std::optional<Pose2> motion_T_world_laser = MotionPrediction();
-        if (config_.recovery_search && increment_measured && motion_T_world_laser &&
-            !WithinCorrectionBounds(Between(*motion_T_world_laser, predicted_T_world_laser))) {
-          if (const std::optional<IcpResult> better =
-                  MotionBetterByOdometryTotal(source, icp, odometry_laser)) {
-            RecordIcp(*better, &result);
-            result.status = ScanOdometryStatus::kRecovered;
-            T_world_laser = better->T_target_source;
-          }
-        }
-      } else if (config_.recovery_search && increment_measured &&
-                 ConstantVelocityOverrulesOdometry(predicted_T_world_laser, icp.T_target_source)) {
-        result.status = ScanOdometryStatus::kRecovered;
-        T_world_laser = icp.T_target_source;
-      } else {
-        result.status = ScanOdometryStatus::kFallbackCorrectionTooLarge;
-      }
-      if (config_.recovery_search &&
-          (result.status == ScanOdometryStatus::kFallbackNotConverged ||
-           result.status == ScanOdometryStatus::kFallbackCorrectionTooLarge)) {
-        if (const std::optional<IcpResult> recovered = Recover(source, predicted_T_world_laser)) {
-          RecordIcp(*recovered, &result);
-          result.status = ScanOdometryStatus::kRecovered;
-          T_world_laser = recovered->T_target_source;
-        }
-      }
+      T_world_laser = Register(points, predicted_T_world_laser,
+                               DisputingMotion(predicted_T_world_laser, increment_measured),
+                               odometry_laser, result);
     }
     result.converged = IsIcpPose(result.status);
     result.fell_back = !result.converged;

@@ -139,22 +139,26 @@ class ScanOdometry {
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
   bool WithinCorrectionBounds(const Pose2& correction) const;
-  /// True when the odometry's prediction and the previous ICP step repeated (constant velocity)
-  /// part by more than the correction bounds, and ICP, started from the odometry's prediction,
-  /// converged within those bounds of the constant-velocity one.
-  bool ConstantVelocityOverrulesOdometry(const Pose2& predicted_T_world_laser,
-                                         const Pose2& icp_T_world_laser) const;
-  /// The previous ICP step repeated (constant velocity), when the last scan converged.
-  std::optional<Pose2> MotionPrediction() const;
+  /// ICP from the prediction, its checks and the recovery: the scan's pose (the prediction when
+  /// it falls back), with the status and ICP figures written to `result`.
+  Pose2 Register(const std::vector<Eigen::Vector2d>& points, const Pose2& predicted_T_world_laser,
+                 const std::optional<Pose2>& disputing_motion, const Pose2& odometry_laser,
+                 ScanOdometryResult& result) const;
+  /// The previous ICP step repeated (constant velocity) when it parts from the odometry's
+  /// prediction by more than the correction bounds (recovery on, odometry at this scan and the
+  /// one before, the last scan converged); nullopt otherwise.
+  std::optional<Pose2> DisputingMotion(const Pose2& predicted_T_world_laser,
+                                       bool increment_measured) const;
   /// ICP converged within the correction bounds of the odometry's prediction, which parts from
-  /// the constant-velocity one beyond them. When ICP from the latter converges within its bounds
-  /// too (the scan cannot tell the two apart: a corridor), returns that result if its motion over
-  /// the scans in `odometry_window_` agrees better with the odometry's total over them (its
-  /// translation: a stalled reading's error is where the robot is, not how it is turned), a
-  /// result more than the correction bounds from the first and with a full window: a stale reading
-  /// that catches up is right in total, not in its last step (docs/REGISTRATION.md, "Odometry
-  /// that stalls, then catches up").
+  /// the constant-velocity one (`motion_T_world_laser`) beyond them. When ICP from the latter
+  /// converges within its bounds too (the scan cannot tell the two apart: a corridor), returns that
+  /// result if its motion over the scans in `odometry_window_` agrees better with the odometry's
+  /// total over them (its translation: a stalled reading's error is where the robot is, not how it
+  /// is turned), a result more than the correction bounds from the first and with a full window: a
+  /// stale reading that catches up is right in total, not in its last step (docs/REGISTRATION.md,
+  /// "Odometry that stalls, then catches up").
   std::optional<IcpResult> MotionBetterByOdometryTotal(const std::vector<Eigen::Vector2d>& source,
+                                                       const Pose2& motion_T_world_laser,
                                                        const IcpResult& from_odometry,
                                                        const Pose2& odometry_laser) const;
 
