@@ -84,8 +84,8 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& c) {
   RequireOdometryField(
       std::isfinite(c.recovery_step_rotation_rad) && c.recovery_step_rotation_rad >= 0.001,
       "recovery_step_rotation_rad", "must be finite and >= 0.001");
-  // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 91 =
-  // 11 011 poses (2-6 ms); this bound keeps a search under about a second.
+  // Each searched pose costs one lookup per scan point: the default window has 11 x 11 x 181 =
+  // 21 901 poses (4-12 ms); this bound keeps a search under about a second.
   const double translations =
       2.0 * std::floor(c.recovery_window_translation_m / c.recovery_step_translation_m) + 1.0;
   const double rotations =
@@ -215,10 +215,7 @@ std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
       WithinCorrectionBounds(Between(from_odometry.T_target_source, from_motion.T_target_source))) {
     return std::nullopt;
   }
-  // Where the odometry's total since the oldest scan of the window puts this scan.
-  const Past& oldest = odometry_window_.front();
-  const Pose2 total_T_world_laser =
-      oldest.T_world_laser * Between(oldest.T_odom_laser, odometry_laser);
+  const Pose2 total_T_world_laser = OdometryTotal(odometry_laser);
   const auto off_m = [&](const Pose2& T_world_laser) {
     return TranslationNorm(Between(total_T_world_laser, T_world_laser));
   };
@@ -267,13 +264,54 @@ Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
   if (config_.recovery_search &&
       (result.status == ScanOdometryStatus::kFallbackNotConverged ||
        result.status == ScanOdometryStatus::kFallbackCorrectionTooLarge)) {
-    if (const std::optional<IcpResult> recovered = Recover(source, predicted_T_world_laser)) {
+    if (const std::optional<IcpResult> recovered =
+            RecoverFrom(source, predicted_T_world_laser,
+                        OdometryTotalDisputing(predicted_T_world_laser, odometry_laser))) {
       RecordIcp(*recovered, &result);
       result.status = ScanOdometryStatus::kRecovered;
       T_world_laser = recovered->T_target_source;
     }
   }
   return T_world_laser;
+}
+
+// Where the odometry's total since the oldest scan of the window puts this scan.
+Pose2 ScanOdometry::OdometryTotal(const Pose2& odometry_laser) const {
+  const Past& oldest = odometry_window_.front();
+  return oldest.T_world_laser * Between(oldest.T_odom_laser, odometry_laser);
+}
+
+// Where the odometry's total over the last scans puts this scan (from the oldest of them), when
+// it parts from the odometry's last step beyond the correction bounds: the motion the scans
+// measured while the odometry stood still, reported again in one late step (docs/REGISTRATION.md,
+// "Odometry that stalls, then catches up"). Only with a full window of scans with odometry.
+std::optional<Pose2> ScanOdometry::OdometryTotalDisputing(const Pose2& predicted_T_world_laser,
+                                                          const Pose2& odometry_laser) const {
+  if (odometry_window_.size() < kOdometryWindowScans) return std::nullopt;
+  const Pose2 total_T_world_laser = OdometryTotal(odometry_laser);
+  if (WithinCorrectionBounds(Between(predicted_T_world_laser, total_T_world_laser))) {
+    return std::nullopt;
+  }
+  return total_T_world_laser;
+}
+
+// ICP failed from the odometry's prediction: ICP from the odometry's total when it disputes the
+// prediction (cheap, and right when the last step was a late one), then the search around the
+// prediction, then around the total.
+std::optional<IcpResult> ScanOdometry::RecoverFrom(const std::vector<Eigen::Vector2d>& source,
+                                                   const Pose2& predicted_T_world_laser,
+                                                   const std::optional<Pose2>& total) const {
+  if (total) {
+    const IcpResult from_total = AlignPointToLine(*target_, source, *total, config_.icp);
+    if (from_total.converged &&
+        WithinCorrectionBounds(Between(*total, from_total.T_target_source))) {
+      return from_total;
+    }
+  }
+  if (std::optional<IcpResult> recovered = Recover(source, predicted_T_world_laser)) {
+    return recovered;
+  }
+  return total ? Recover(source, *total) : std::nullopt;
 }
 
 ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,

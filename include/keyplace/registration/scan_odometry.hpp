@@ -62,11 +62,13 @@ struct ScanOdometryConfig {
   // (only with odometry at this scan and the one before). When the two predictions part so but
   // ICP converged within the bounds of the odometry's, ICP also runs from the previous step
   // repeated, and a result of it more than the bounds away is taken (kRecovered) when the
-  // odometry's total over the last scans agrees better with it: a stale reading caught up.
-  // false: fall back at once.
+  // odometry's total over the last scans agrees better with it: a stale reading caught up. When
+  // ICP from the prediction fails and that total parts from it beyond the bounds, ICP runs from
+  // the total first (a late turn outside ICP's basin), and the search around the total follows
+  // the one around the prediction. false: fall back at once.
   bool recovery_search = true;
   double recovery_window_translation_m = 0.5;
-  double recovery_window_rotation_rad = 0.7853981634;  // 45 deg
+  double recovery_window_rotation_rad = 1.5707963268;  // 90 deg
   double recovery_step_translation_m = 0.1;
   double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
 };
@@ -139,6 +141,19 @@ class ScanOdometry {
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
   bool WithinCorrectionBounds(const Pose2& correction) const;
+  /// The odometry's total over `odometry_window_` (not empty) applied to its oldest pose.
+  Pose2 OdometryTotal(const Pose2& odometry_laser) const;
+  /// The odometry's total over `odometry_window_` applied to its oldest pose, when the window is
+  /// full and that parts from the prediction (the odometry's last step) beyond the correction
+  /// bounds; nullopt otherwise.
+  std::optional<Pose2> OdometryTotalDisputing(const Pose2& predicted_T_world_laser,
+                                              const Pose2& odometry_laser) const;
+  /// After ICP from the prediction failed: ICP from `total` (OdometryTotalDisputing), the search
+  /// around the prediction, the search around `total`; the first that converges within the
+  /// correction bounds of its start.
+  std::optional<IcpResult> RecoverFrom(const std::vector<Eigen::Vector2d>& source,
+                                       const Pose2& predicted_T_world_laser,
+                                       const std::optional<Pose2>& total) const;
   /// ICP from the prediction, its checks and the recovery: the scan's pose (the prediction when
   /// it falls back), with the status and ICP figures written to `result`.
   Pose2 Register(const std::vector<Eigen::Vector2d>& points, const Pose2& predicted_T_world_laser,
