@@ -2,10 +2,14 @@
 // (data/, default mapping) embedded among distractor submaps (EmbedAmongDistractors: real
 // submaps moved far away) up to 10^2, 10^3, 10^4 and 10^5 submaps, queried with every 25th of the
 // 500 queries of `keyplace localize` (default preset; 10^2 is the map's first 100 submaps), with
-// the dense index and exhaustively (`none`, the oracle) in the same process. Counters per query:
+// the dense index, the dense index after retrieval (`words`, place.retrieval=words) and
+// exhaustively (`none`, the oracle) in the same process. Counters per query:
 // s_per_query (CPU time of recognition), pairing_s and verification_s (wall), candidates (places
 // with >= mu pairs), correct (fraction of queries answered within 0.5 m / 10 deg),
-// recognizer_mib (heap held by the recognizer: its places and descriptor index).
+// places_mib (heap of the places: keypoints, descriptors, occupancy), recognizer_mib (heap the
+// recognizer adds to them: descriptor index, and with `words` the vocabulary and word lists),
+// build_s (wall time to make the recognizer from the places: index, and with `words` the
+// vocabulary learned from the map, what loading a map costs beyond reading it).
 //
 // Distractors: the maps named in KEYPLACE_DISTRACTOR_MAPS (colon-separated .kpm files; the
 // benchmark in docs/ uses the maps of the other buildings), else copies of the bundled map itself
@@ -14,6 +18,7 @@
 //       --benchmark_filter='/(100|1000|10000)/'
 // (one command line; 10^5 `none` alone takes minutes per iteration).
 
+#include <chrono>
 #include <cstddef>
 #include <cstdlib>
 #include <memory>
@@ -89,16 +94,25 @@ keyplace::GlobalMap MapOfSize(const Bundled& b, std::size_t submaps) {
   return keyplace::EmbedAmongDistractors(b.map, b.distractors, options);
 }
 
-void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex index) {
+void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex index,
+                PlaceRecognitionConfig::Retrieval retrieval) {
   const Bundled& b = Load();
   // One thread: s_per_query is the benchmark thread's CPU time.
   const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
   PlaceRecognitionConfig config;
   config.descriptor_index = index;
+  config.retrieval = retrieval;
   // The map is not needed once its places are made; only the recognizer stays, as in a robot.
+  const double heap_start_mib = HeapInUseMiB();
+  std::vector<keyplace::Place> places =
+      keyplace::PlacesFromMap(MapOfSize(b, static_cast<std::size_t>(state.range(0))));
   const double heap_before_mib = HeapInUseMiB();
-  const auto recognizer = std::make_unique<const keyplace::PlaceRecognizer>(
-      keyplace::PlacesFromMap(MapOfSize(b, static_cast<std::size_t>(state.range(0)))), config);
+  const double places_mib = heap_before_mib - heap_start_mib;
+  const auto build_start = std::chrono::steady_clock::now();
+  const auto recognizer =
+      std::make_unique<const keyplace::PlaceRecognizer>(std::move(places), config);
+  const double build_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
   const double recognizer_mib = HeapInUseMiB() - heap_before_mib;
   double pairing = 0.0;
   double verification = 0.0;
@@ -124,18 +138,28 @@ void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex
   state.counters["candidates"] = candidates / n;
   state.counters["correct"] = correct / n;
   state.counters["places"] = static_cast<double>(recognizer->places().size());
+  state.counters["places_mib"] = places_mib;
   state.counters["recognizer_mib"] = recognizer_mib;
+  state.counters["build_s"] = build_s;
 }
 
 using Index = PlaceRecognitionConfig::DescriptorIndex;
-BENCHMARK_CAPTURE(BM_MapSize, dense, Index::kDense)
+using Retrieval = PlaceRecognitionConfig::Retrieval;
+BENCHMARK_CAPTURE(BM_MapSize, dense, Index::kDense, Retrieval::kExact)
     ->Arg(100)
     ->Arg(1000)
     ->Arg(10000)
     ->Arg(100000)
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MapSize, none, Index::kNone)
+BENCHMARK_CAPTURE(BM_MapSize, words, Index::kDense, Retrieval::kWords)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MapSize, none, Index::kNone, Retrieval::kExact)
     ->Arg(100)
     ->Arg(1000)
     ->Arg(10000)

@@ -245,17 +245,11 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
     blocks.emplace_back(first_place, end_place);
     first_place = end_place;
   }
-  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t block) {
-    const auto [first_place, end_place] = blocks[block];
+  // The pairs of the places [first_place, end_place), contiguous in the index, by one product.
+  const auto find_in_run = [&](std::size_t first_place, std::size_t end_place) {
     const auto begin = static_cast<std::size_t>(first_of_place_[first_place]);
     const auto count = static_cast<std::size_t>(first_of_place_[end_place]) - begin;
     if (count == 0) return;
-    // A block none of whose places is searched (retrieval narrowed them) costs no product.
-    if (std::none_of(searched.begin() + static_cast<std::ptrdiff_t>(first_place),
-                     searched.begin() + static_cast<std::ptrdiff_t>(end_place),
-                     [](char s) { return s != 0; })) {
-      return;
-    }
     Eigen::MatrixXd dots(static_cast<Eigen::Index>(count),
                          static_cast<Eigen::Index>(query.size()));  // keypoint x query row
     dots.noalias() =
@@ -267,7 +261,6 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
       const double radius2 = SearchRadius2(chi2_threshold, query_norm);
       const double* column = dots.col(static_cast<Eigen::Index>(c)).data();
       for (std::size_t p = first_place; p < end_place; ++p) {
-        if (!searched[p]) continue;
         const auto end = static_cast<std::size_t>(first_of_place_[p + 1]);
         for (auto k = static_cast<std::size_t>(first_of_place_[p]); k < end; ++k) {
           DescriptorPair pair;
@@ -277,6 +270,21 @@ void SqrtDescriptorIndex::FindPairs(const std::vector<BetaGridDescriptor>& query
           }
         }
       }
+    }
+  };
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t block) {
+    const auto [first_place, end_place] = blocks[block];
+    // One product per run of consecutive searched places: the whole block when every place is
+    // searched, a few rows when retrieval kept a few places (it costs no product elsewhere).
+    for (std::size_t run_first = first_place; run_first < end_place;) {
+      if (!searched[run_first]) {
+        ++run_first;
+        continue;
+      }
+      std::size_t run_end = run_first + 1;
+      while (run_end < end_place && searched[run_end]) ++run_end;
+      find_in_run(run_first, run_end);
+      run_first = run_end;
     }
   });
 }

@@ -109,9 +109,13 @@ void KeepRetrieved(const PlaceWords& words, const std::vector<BetaGridDescriptor
     if (searched[p]) order.push_back(static_cast<int>(p));
   }
   if (order.size() <= count) return;
-  std::stable_sort(order.begin(), order.end(), [&similarity](int a, int b) {
-    return similarity[static_cast<std::size_t>(a)] > similarity[static_cast<std::size_t>(b)];
-  });
+  // Only the first `count` need an order: O(places log count), not a sort of the whole map.
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
+                    [&similarity](int a, int b) {
+                      const double similarity_a = similarity[static_cast<std::size_t>(a)];
+                      const double similarity_b = similarity[static_cast<std::size_t>(b)];
+                      return similarity_a > similarity_b || (similarity_a == similarity_b && a < b);
+                    });
   for (std::size_t k = count; k < order.size(); ++k)
     searched[static_cast<std::size_t>(order[k])] = 0;
 }
