@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -50,13 +51,80 @@ std::vector<int> Assign(const RowMatrixF& samples, const RowMatrixF& centres) {
   return word;
 }
 
+// Lloyd's k-means from evenly spaced samples (deterministic): `k` centres (k <= samples); an
+// empty cluster keeps its centre.
+RowMatrixF KMeans(const RowMatrixF& samples, std::size_t k) {
+  RowMatrixF centres(static_cast<Eigen::Index>(k), kBetaGridBins);
+  for (std::size_t w = 0; w < k; ++w) {
+    centres.row(static_cast<Eigen::Index>(w)) =
+        samples.row(static_cast<Eigen::Index>(w * static_cast<std::size_t>(samples.rows()) / k));
+  }
+  for (int iteration = 0; iteration < kKMeansIterations; ++iteration) {
+    const std::vector<int> word = Assign(samples, centres);
+    RowMatrixF sums = RowMatrixF::Zero(centres.rows(), kBetaGridBins);
+    std::vector<int> counts(k, 0);
+    for (Eigen::Index r = 0; r < samples.rows(); ++r) {
+      sums.row(word[static_cast<std::size_t>(r)]) += samples.row(r);
+      ++counts[static_cast<std::size_t>(word[static_cast<std::size_t>(r)])];
+    }
+    for (std::size_t w = 0; w < k; ++w) {
+      if (counts[w] > 0) {
+        centres.row(static_cast<Eigen::Index>(w)) =
+            sums.row(static_cast<Eigen::Index>(w)) / static_cast<float>(counts[w]);
+      }
+    }
+  }
+  return centres;
+}
+
+// The rows of `matrix` listed in `rows`, in that order.
+RowMatrixF RowsOf(const RowMatrixF& matrix, const std::vector<Eigen::Index>& rows) {
+  RowMatrixF selected(static_cast<Eigen::Index>(rows.size()), kBetaGridBins);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    selected.row(static_cast<Eigen::Index>(k)) = matrix.row(rows[k]);
+  }
+  return selected;
+}
+
+// For each of `words` words, the rows assigned to it (increasing).
+std::vector<std::vector<Eigen::Index>> RowsByWord(const std::vector<int>& word_of_row,
+                                                  std::size_t words) {
+  std::vector<std::vector<Eigen::Index>> rows(words);
+  for (std::size_t r = 0; r < word_of_row.size(); ++r) {
+    rows[static_cast<std::size_t>(word_of_row[r])].push_back(static_cast<Eigen::Index>(r));
+  }
+  return rows;
+}
+
 }  // namespace
+
+// Two levels: sqrt(n_words) top words, each split into words of its own, so that a descriptor
+// finds its word among about 2 sqrt(n_words) centres instead of n_words (a map loads in
+// O(keypoints x sqrt(words)), not O(keypoints x words)).
+void PlaceWords::LearnVocabulary(const RowMatrixF& samples, std::size_t n_words) {
+  const auto branches =
+      static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n_words)) - 1e-9));
+  top_ = KMeans(samples, branches);
+  first_word_.assign(1, 0);
+  leaves_.clear();
+  for (const std::vector<Eigen::Index>& rows :
+       RowsByWord(Assign(samples, top_), static_cast<std::size_t>(top_.rows()))) {
+    // Words where the descriptors are: a top word gets its share of n_words by its samples (at
+    // least one, at most one per sample); one no sample chose (k-means left it empty) is itself.
+    const auto share = static_cast<std::size_t>(std::lround(
+        static_cast<double>(n_words * rows.size()) / static_cast<double>(samples.rows())));
+    leaves_.push_back(rows.empty() ? RowMatrixF(top_.row(static_cast<Eigen::Index>(leaves_.size())))
+                                   : KMeans(RowsOf(samples, rows),
+                                            std::clamp<std::size_t>(share, 1, rows.size())));
+    first_word_.push_back(first_word_.back() + static_cast<int>(leaves_.back().rows()));
+  }
+}
 
 PlaceWords::PlaceWords(const std::vector<Place>& places) : num_places_(places.size()) {
   std::size_t keypoints = 0;
   for (const Place& place : places) keypoints += place.descriptors.size();
   if (keypoints == 0) return;
-  const std::size_t n_words = std::min(WordCount(keypoints), keypoints);
+  std::size_t n_words = std::min(WordCount(keypoints), keypoints);
   const std::size_t stride = (keypoints + kMaxVocabularySamples - 1) / kMaxVocabularySamples;
   RowMatrixF samples(static_cast<Eigen::Index>((keypoints + stride - 1) / stride), kBetaGridBins);
   std::size_t k = 0;
@@ -66,28 +134,8 @@ PlaceWords::PlaceWords(const std::vector<Place>& places) : num_places_(places.si
       if (k++ % stride == 0) FillRoots(descriptor, samples.row(row++).data());
     }
   }
-  // Lloyd's k-means from evenly spaced samples (deterministic); an empty cluster keeps its centre.
-  RowMatrixF centres(static_cast<Eigen::Index>(n_words), kBetaGridBins);
-  for (std::size_t w = 0; w < n_words; ++w) {
-    centres.row(static_cast<Eigen::Index>(w)) = samples.row(
-        static_cast<Eigen::Index>(w * static_cast<std::size_t>(samples.rows()) / n_words));
-  }
-  for (int iteration = 0; iteration < kKMeansIterations; ++iteration) {
-    const std::vector<int> word = Assign(samples, centres);
-    RowMatrixF sums = RowMatrixF::Zero(centres.rows(), kBetaGridBins);
-    std::vector<int> counts(n_words, 0);
-    for (Eigen::Index r = 0; r < samples.rows(); ++r) {
-      sums.row(word[static_cast<std::size_t>(r)]) += samples.row(r);
-      ++counts[static_cast<std::size_t>(word[static_cast<std::size_t>(r)])];
-    }
-    for (std::size_t w = 0; w < n_words; ++w) {
-      if (counts[w] > 0) {
-        centres.row(static_cast<Eigen::Index>(w)) =
-            sums.row(static_cast<Eigen::Index>(w)) / static_cast<float>(counts[w]);
-      }
-    }
-  }
-  centres_ = std::move(centres);
+  LearnVocabulary(samples, n_words);
+  n_words = static_cast<std::size_t>(first_word_.back());
 
   // Word counts per place, then tf-idf weights normalised per place.
   std::vector<std::vector<std::pair<int, int>>> counts_of_place(places.size());
@@ -137,7 +185,18 @@ std::vector<int> PlaceWords::WordsOf(const std::vector<BetaGridDescriptor>& desc
   for (std::size_t k = 0; k < descriptors.size(); ++k) {
     FillRoots(descriptors[k], roots.row(static_cast<Eigen::Index>(k)).data());
   }
-  return Assign(roots, centres_);
+  std::vector<int> word(descriptors.size(), 0);
+  const std::vector<std::vector<Eigen::Index>> rows_of_top =
+      RowsByWord(Assign(roots, top_), leaves_.size());
+  for (std::size_t t = 0; t < leaves_.size(); ++t) {
+    const std::vector<Eigen::Index>& rows = rows_of_top[t];
+    if (rows.empty()) continue;
+    const std::vector<int> leaf = Assign(RowsOf(roots, rows), leaves_[t]);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      word[static_cast<std::size_t>(rows[k])] = first_word_[t] + leaf[k];
+    }
+  }
+  return word;
 }
 
 std::vector<double> PlaceWords::Similarities(const std::vector<BetaGridDescriptor>& query) const {

@@ -1,7 +1,7 @@
 #pragma once
 // The retrieval stage of place recognition (PlaceRecognitionConfig::Retrieval::kWords): a
-// vocabulary of FLIRT descriptors learned from the map itself (k-means on the square roots of the
-// descriptors, where the Euclidean distance bounds the symmetric chi2 of a pair, see
+// vocabulary of FLIRT descriptors learned from the map itself (two levels of k-means on the square
+// roots of the descriptors, where the Euclidean distance bounds the symmetric chi2 of a pair, see
 // descriptor_index.cpp) and a tf-idf weighted word histogram per place. A query's histogram
 // against every place's (an inverted file: only the places sharing a word are touched) gives the
 // places worth pairing; Algorithm 3, RANSAC and the checks then run on those alone.
@@ -20,7 +20,8 @@ namespace keyplace {
 class PlaceWords {
  public:
   /// Learns the vocabulary from the places' descriptors (deterministic) and indexes each place:
-  /// O(keypoints x words), which a recognizer that relearns it on every AddPlace pays per place.
+  /// O(keypoints x sqrt(words)), which a recognizer that relearns it on every AddPlace pays per
+  /// place.
   explicit PlaceWords(const std::vector<Place>& places);
 
   /// The cosine similarity of the query's tf-idf word histogram with each place's, in the order
@@ -30,10 +31,18 @@ class PlaceWords {
   std::size_t words() const { return idf_.size(); }
 
  private:
-  // The word of each descriptor: its nearest centre in square-root space.
+  using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  // Learns top_, leaves_ and first_word_ from square-root descriptors (a row each), about
+  // n_words words (<= samples).
+  void LearnVocabulary(const RowMatrixF& samples, std::size_t n_words);
+  // The word of each descriptor: its nearest leaf under its nearest top centre.
   std::vector<int> WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const;
 
-  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> centres_;  // a word a row
+  // A two-level vocabulary: top_ (a centre a row) splits square-root space, leaves_[t] the part of
+  // top word t; the words are the leaves, those of top word t numbered from first_word_[t].
+  RowMatrixF top_;
+  std::vector<RowMatrixF> leaves_;
+  std::vector<int> first_word_;
   std::vector<double> idf_;  // log(places / places holding the word)
   std::vector<std::vector<std::pair<int, double>>> postings_;  // per word: (place, weight)
   std::size_t num_places_ = 0;

@@ -36,7 +36,8 @@ TEST(PlaceWords, APlaceIsTheMostSimilarToTheDescriptorsOfItsNeighbourhood) {
   const PlaceWords words(places);
   std::size_t keypoints = 0;
   for (const Place& place : places) keypoints += place.descriptors.size();
-  EXPECT_EQ(words.words(), keypoints / 8);  // one word per 8 keypoints
+  // One word per 8 keypoints, give or take the rounding of each top word's share.
+  EXPECT_NEAR(static_cast<double>(words.words()), keypoints / 8.0, keypoints / 8.0 * 0.02);
   int checked = 0;
   for (std::size_t p = 2; p + 2 < places.size(); ++p) {
     if (places[p + 2].id != places[p - 2].id + 4) continue;  // not five adjacent submaps
