@@ -5,7 +5,7 @@ Usage: scripts/plot-map-size.py OUT.svg RESULTS.json [RESULTS.json ...]
 RESULTS.json: the benchmark's --benchmark_out (--benchmark_out_format=json); a variant found in
 several files is taken from the last. Left: CPU seconds
 per query against submaps, one line per variant (dense, words, none); right: the time to make
-the recognizer from the places (index and vocabulary) and the heap it adds per submap.
+the recognizer from the places (index and vocabulary).
 Needs matplotlib (Debian's python3-matplotlib).
 """
 

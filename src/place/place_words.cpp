@@ -110,7 +110,8 @@ void PlaceWords::LearnVocabulary(const RowMatrixF& samples, std::size_t n_words)
   for (const std::vector<Eigen::Index>& rows :
        RowsByWord(Assign(samples, top_), static_cast<std::size_t>(top_.rows()))) {
     // Words where the descriptors are: a top word gets its share of n_words by its samples (at
-    // least one, at most one per sample); one no sample chose (k-means left it empty) is itself.
+    // least one, at most one per sample); one no sample chose (k-means left it empty) is itself,
+    // a word no descriptor of the map has (idf 0).
     const auto share = static_cast<std::size_t>(std::lround(
         static_cast<double>(n_words * rows.size()) / static_cast<double>(samples.rows())));
     leaves_.push_back(rows.empty() ? RowMatrixF(top_.row(static_cast<Eigen::Index>(leaves_.size())))

@@ -32,8 +32,8 @@ class PlaceWords {
 
  private:
   using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  // Learns top_, leaves_ and first_word_ from square-root descriptors (a row each), about
-  // n_words words (<= samples).
+  // Learns top_, leaves_ and first_word_ from square-root descriptors (a row each): about n_words
+  // words (n_words <= samples).
   void LearnVocabulary(const RowMatrixF& samples, std::size_t n_words);
   // The word of each descriptor: its nearest leaf under its nearest top centre.
   std::vector<int> WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const;

@@ -64,7 +64,7 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
               "rejected one is taken when the previous step repeated confirms it against the "
               "odometry, and an accepted one is retried from that step when the odometry's total "
               "says its last step caught up; a failed one is retried from that total first when "
-              "it parts from the prediction")
+              "both it and the previous step part from the odometry's last step")
         .Double("recovery_window_translation_m", &C::recovery_window_translation_m, "m",
                 "the search covers this much translation around the prediction ...")
         .Double("recovery_window_rotation_rad", &C::recovery_window_rotation_rad, "rad",

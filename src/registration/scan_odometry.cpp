@@ -264,9 +264,13 @@ Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
   if (config_.recovery_search &&
       (result.status == ScanOdometryStatus::kFallbackNotConverged ||
        result.status == ScanOdometryStatus::kFallbackCorrectionTooLarge)) {
+    // The total only when the odometry's last step also parts from the previous motion: a late
+    // step, not ICP having corrected the odometry over the window (drift, slip).
+    const std::optional<Pose2> total =
+        disputing_motion ? OdometryTotalDisputing(predicted_T_world_laser, odometry_laser)
+                         : std::nullopt;
     if (const std::optional<IcpResult> recovered =
-            RecoverFrom(source, predicted_T_world_laser,
-                        OdometryTotalDisputing(predicted_T_world_laser, odometry_laser))) {
+            RecoverFrom(source, predicted_T_world_laser, total)) {
       RecordIcp(*recovered, &result);
       result.status = ScanOdometryStatus::kRecovered;
       T_world_laser = recovered->T_target_source;

@@ -504,6 +504,12 @@ TEST(ScanOdometryTest, NinetyDegreeTurnInOneScanWithStalledOdometry) {
   EXPECT_LT(run.worst_heading_error_deg, 1.0);
   EXPECT_LT(run.end_error_m, 0.05);
   EXPECT_EQ(run.fell_back, 0);
+  // A search of +-45 deg cannot reach the turn: the turn scan falls back, 90 deg off.
+  ScanOdometryConfig narrow;
+  narrow.recovery_window_rotation_rad = DegToRad(45.0);
+  const ScriptedRun narrow_run = DriveScript(turn, narrow);
+  EXPECT_GT(narrow_run.worst_heading_error_deg, 80.0);
+  EXPECT_GE(narrow_run.fell_back, 1);
   ScanOdometryConfig plain;
   plain.recovery_search = false;
   EXPECT_GT(DriveScript(turn, plain).worst_heading_error_deg, 80.0);

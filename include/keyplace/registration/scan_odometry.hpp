@@ -63,9 +63,10 @@ struct ScanOdometryConfig {
   // ICP converged within the bounds of the odometry's, ICP also runs from the previous step
   // repeated, and a result of it more than the bounds away is taken (kRecovered) when the
   // odometry's total over the last scans agrees better with it: a stale reading caught up. When
-  // ICP from the prediction fails and that total parts from it beyond the bounds, ICP runs from
-  // the total first (a late turn outside ICP's basin), and the search around the total follows
-  // the one around the prediction. false: fall back at once.
+  // ICP from the prediction fails, the odometry's last step parts from the previous step repeated
+  // and its total from the prediction, both beyond the bounds, ICP runs from the total first (a
+  // late turn outside ICP's basin), and the search around the total follows the one around the
+  // prediction. false: fall back at once.
   bool recovery_search = true;
   double recovery_window_translation_m = 0.5;
   double recovery_window_rotation_rad = 1.5707963268;  // 90 deg
@@ -79,9 +80,10 @@ void ValidateScanOdometryConfig(const ScanOdometryConfig& config);
 enum class ScanOdometryStatus {
   kFirstScan,   // defines the world frame (= odometry frame at the first scan)
   kRegistered,  // ICP converged and was accepted
-  // ICP failed from the prediction and converged from a searched pose, or converged beyond the
-  // bounds where the previous step repeated says that the odometry glitched, or converged from
-  // the previous step repeated where the odometry's total says its last step caught up
+  // ICP failed from the prediction and converged from a searched pose or from the odometry's
+  // total over the last scans (a late step), or converged beyond the bounds where the previous
+  // step repeated says that the odometry glitched, or converged from the previous step repeated
+  // where the odometry's total says its last step caught up
   kRecovered,
   kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
   kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
@@ -136,8 +138,8 @@ class ScanOdometry {
 
  private:
   void AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser, const Pose2& T_world_laser);
-  /// ICP from the best pose of the recovery search around the prediction, when it converges
-  /// close to that pose.
+  /// ICP from the best pose of the recovery search around `predicted_T_world_laser` (the
+  /// odometry's prediction, or its total), when it converges close to that pose.
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
   bool WithinCorrectionBounds(const Pose2& correction) const;
