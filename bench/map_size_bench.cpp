@@ -145,27 +145,16 @@ void BM_MapSize(benchmark::State& state, PlaceRecognitionConfig::DescriptorIndex
 
 using Index = PlaceRecognitionConfig::DescriptorIndex;
 using Retrieval = PlaceRecognitionConfig::Retrieval;
-BENCHMARK_CAPTURE(BM_MapSize, dense, Index::kDense, Retrieval::kExact)
-    ->Arg(100)
-    ->Arg(1000)
-    ->Arg(10000)
-    ->Arg(100000)
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MapSize, words, Index::kDense, Retrieval::kWords)
-    ->Arg(100)
-    ->Arg(1000)
-    ->Arg(10000)
-    ->Arg(100000)
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MapSize, none, Index::kNone, Retrieval::kExact)
-    ->Arg(100)
-    ->Arg(1000)
-    ->Arg(10000)
-    ->Arg(100000)
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
+
+// 10^2 to 10^5 submaps, one iteration each (10^5 `none` alone takes minutes per iteration).
+void MapSizes(benchmark::internal::Benchmark* benchmark) {
+  benchmark->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000)->Iterations(1)->Unit(
+      benchmark::kMillisecond);
+}
+
+BENCHMARK_CAPTURE(BM_MapSize, dense, Index::kDense, Retrieval::kExact)->Apply(MapSizes);
+BENCHMARK_CAPTURE(BM_MapSize, words, Index::kDense, Retrieval::kWords)->Apply(MapSizes);
+BENCHMARK_CAPTURE(BM_MapSize, none, Index::kNone, Retrieval::kExact)->Apply(MapSizes);
 
 }  // namespace
 
