@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace keyplace {
 
@@ -66,16 +67,32 @@ double RecallAtPrecision(const std::vector<PrPoint>& curve, double min_precision
 
 namespace keyplace {
 
-bool IsSelfMatch(SelfMatchRule rule, std::vector<int> query_scans, std::vector<int> place_scans) {
+namespace {
+
+// `scans` when it is strictly increasing, else a sorted copy without repeats in `storage`.
+const std::vector<int>& IncreasingScans(const std::vector<int>& scans, std::vector<int>& storage) {
+  if (std::adjacent_find(scans.begin(), scans.end(), std::greater_equal<>()) == scans.end()) {
+    return scans;
+  }
+  storage = scans;
+  std::sort(storage.begin(), storage.end());
+  storage.erase(std::unique(storage.begin(), storage.end()), storage.end());
+  return storage;
+}
+
+}  // namespace
+
+bool IsSelfMatch(SelfMatchRule rule, const std::vector<int>& query_scans,
+                 const std::vector<int>& place_scans) {
   if (rule == SelfMatchRule::kNone) return false;
-  std::sort(query_scans.begin(), query_scans.end());
-  query_scans.erase(std::unique(query_scans.begin(), query_scans.end()), query_scans.end());
-  std::sort(place_scans.begin(), place_scans.end());
-  place_scans.erase(std::unique(place_scans.begin(), place_scans.end()), place_scans.end());
-  if (rule == SelfMatchRule::kSameScans) return query_scans == place_scans;
-  auto q = query_scans.begin();
-  auto p = place_scans.begin();
-  while (q != query_scans.end() && p != place_scans.end()) {
+  std::vector<int> query_storage;
+  std::vector<int> place_storage;
+  const std::vector<int>& query = IncreasingScans(query_scans, query_storage);
+  const std::vector<int>& place = IncreasingScans(place_scans, place_storage);
+  if (rule == SelfMatchRule::kSameScans) return query == place;
+  auto q = query.begin();
+  auto p = place.begin();
+  while (q != query.end() && p != place.end()) {
     if (*q == *p) return true;
     if (*q < *p) {
       ++q;

@@ -53,7 +53,10 @@ namespace keyplace {
 enum class SelfMatchRule { kNone, kSameScans, kSharedScan };
 
 /// `query_scans` and `place_scans` are scan indices of the same log (for raw queries: the
-/// corrected indices of the query's scans that have one). Order and duplicates do not matter.
-bool IsSelfMatch(SelfMatchRule rule, std::vector<int> query_scans, std::vector<int> place_scans);
+/// corrected indices of the query's scans that have one). Order and duplicates do not matter;
+/// lists already increasing are read as they are (no copy: the check runs for every place of a
+/// map, per query).
+bool IsSelfMatch(SelfMatchRule rule, const std::vector<int>& query_scans,
+                 const std::vector<int>& place_scans);
 
 }  // namespace keyplace
