@@ -274,8 +274,23 @@ PlaceRecognizer::~PlaceRecognizer() = default;
 
 void PlaceRecognizer::RebuildWords() {
   if (config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
-    words_ = std::make_shared<const PlaceWords>(places_);  // built first: a throw keeps the old
+    words_ = std::make_shared<PlaceWords>(places_);  // built first: a throw keeps the old
   }
+}
+
+void PlaceRecognizer::AddWordsOfLastPlace() {
+  if (!words_) return;  // retrieval exact
+  std::size_t keypoints = 0;
+  for (const Place& place : places_) keypoints += place.descriptors.size();
+  // Learning anew once the map holds twice the keypoints the vocabulary was learned from costs
+  // at most twice the last learning over all the places added (a growing SLAM map learns about
+  // log2(places) times), and keeps about one word per 8 to 16 map keypoints.
+  if (keypoints >= 2 * words_->learned_keypoints()) {
+    RebuildWords();
+    return;
+  }
+  if (words_.use_count() > 1) words_ = std::make_shared<PlaceWords>(*words_);  // a copy shares it
+  words_->Append(places_.back());
 }
 
 void PlaceRecognizer::RebuildIndex() {
@@ -293,7 +308,7 @@ void PlaceRecognizer::AddPlace(Place place) {
                                 ": positions and descriptors differ in size");
   }
   places_.push_back(std::move(place));
-  RebuildWords();
+  AddWordsOfLastPlace();
   if (!index_) return;  // kNone
   if (index_.use_count() > 1) {
     RebuildIndex();  // a copy shares the index: never change it under the copy

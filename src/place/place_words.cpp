@@ -121,67 +121,106 @@ void PlaceWords::LearnVocabulary(const RowMatrixF& samples, std::size_t n_words)
   }
 }
 
-PlaceWords::PlaceWords(const std::vector<Place>& places) : num_places_(places.size()) {
-  std::size_t keypoints = 0;
-  for (const Place& place : places) keypoints += place.descriptors.size();
-  if (keypoints == 0) return;
-  std::size_t n_words = std::min(WordCount(keypoints), keypoints);
-  const std::size_t stride = (keypoints + kMaxVocabularySamples - 1) / kMaxVocabularySamples;
-  RowMatrixF samples(static_cast<Eigen::Index>((keypoints + stride - 1) / stride), kBetaGridBins);
-  std::size_t k = 0;
-  Eigen::Index row = 0;
+PlaceWords::PlaceWords(const std::vector<Place>& places) {
+  for (const Place& place : places) learned_keypoints_ += place.descriptors.size();
+  if (learned_keypoints_ > 0) {
+    const std::size_t n_words = std::min(WordCount(learned_keypoints_), learned_keypoints_);
+    const std::size_t stride =
+        (learned_keypoints_ + kMaxVocabularySamples - 1) / kMaxVocabularySamples;
+    RowMatrixF samples(static_cast<Eigen::Index>((learned_keypoints_ + stride - 1) / stride),
+                       kBetaGridBins);
+    std::size_t k = 0;
+    Eigen::Index row = 0;
+    for (const Place& place : places) {
+      for (const BetaGridDescriptor& descriptor : place.descriptors) {
+        if (k++ % stride == 0) FillRoots(descriptor, samples.row(row++).data());
+      }
+    }
+    LearnVocabulary(samples, n_words);
+  }
   for (const Place& place : places) {
-    for (const BetaGridDescriptor& descriptor : place.descriptors) {
-      if (k++ % stride == 0) FillRoots(descriptor, samples.row(row++).data());
+    place_ids_.push_back(place.id);
+    own_words_.push_back(WordsOf(place.descriptors));
+  }
+  postings_.assign(first_word_.empty() ? 0 : static_cast<std::size_t>(first_word_.back()), {});
+  // By place, then by word within a place: each list in increasing place order.
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    for (const auto& [word, count] : CountsOf(p)) {
+      postings_[static_cast<std::size_t>(word)].emplace_back(static_cast<int>(p), count);
     }
   }
-  LearnVocabulary(samples, n_words);
-  n_words = static_cast<std::size_t>(first_word_.back());
+  Weigh();
+}
 
-  // Word counts per place, then tf-idf weights normalised per place.
-  std::vector<std::vector<std::pair<int, int>>> counts_of_place(places.size());
-  std::vector<int> places_with_word(n_words, 0);
-  std::vector<std::vector<int>> own_words(places.size());
-  for (std::size_t p = 0; p < places.size(); ++p) own_words[p] = WordsOf(places[p].descriptors);
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    std::vector<int> count(n_words, 0);
-    for (int offset = -kNeighbours; offset <= kNeighbours; ++offset) {
-      const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(p) + offset;
-      if (q < 0 || q >= static_cast<std::ptrdiff_t>(places.size())) continue;
-      if (places[static_cast<std::size_t>(q)].id != places[p].id + offset) continue;
-      for (const int w : own_words[static_cast<std::size_t>(q)])
-        ++count[static_cast<std::size_t>(w)];
-    }
-    for (std::size_t w = 0; w < n_words; ++w) {
-      if (count[w] == 0) continue;
-      counts_of_place[p].emplace_back(static_cast<int>(w), count[w]);
-      ++places_with_word[w];
-    }
-  }
-  idf_.resize(n_words);
-  for (std::size_t w = 0; w < n_words; ++w) {
-    idf_[w] = places_with_word[w] > 0
-                  ? std::log(static_cast<double>(places.size()) / places_with_word[w])
-                  : 0.0;
-  }
-  postings_.assign(n_words, {});
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    double norm2 = 0.0;
-    for (const auto& [w, count] : counts_of_place[p]) {
-      const double weight = count * idf_[static_cast<std::size_t>(w)];
-      norm2 += weight * weight;
-    }
-    if (norm2 <= 0.0) continue;
-    const double norm = std::sqrt(norm2);
-    for (const auto& [w, count] : counts_of_place[p]) {
-      postings_[static_cast<std::size_t>(w)].emplace_back(
-          static_cast<int>(p), count * idf_[static_cast<std::size_t>(w)] / norm);
+void PlaceWords::Append(const Place& place) {
+  const std::size_t n = place_ids_.size();
+  place_ids_.push_back(place.id);
+  own_words_.push_back(WordsOf(place.descriptors));
+  // The earlier places whose neighbourhood holds the new one gain its words ...
+  for (std::size_t p = n - std::min<std::size_t>(n, kNeighbours); p < n; ++p) {
+    if (!Neighbours(p, n)) continue;
+    const int earlier = static_cast<int>(p);
+    for (const int word : own_words_[n]) {
+      std::vector<std::pair<int, int>>& list = postings_[static_cast<std::size_t>(word)];
+      // An entry is appended only with a place at most kNeighbours before it: every entry after
+      // place p's is of a place p - kNeighbours or later, so the search stops at an earlier one.
+      auto it = list.rbegin();
+      while (it != list.rend() && it->first != earlier && it->first + kNeighbours >= earlier) ++it;
+      if (it != list.rend() && it->first == earlier) {
+        ++it->second;
+      } else {
+        list.emplace_back(earlier, 1);
+      }
     }
   }
+  // ... and it has its own neighbourhood's.
+  for (const auto& [word, count] : CountsOf(n)) {
+    postings_[static_cast<std::size_t>(word)].emplace_back(static_cast<int>(n), count);
+  }
+  Weigh();
+}
+
+bool PlaceWords::Neighbours(std::size_t p, std::size_t q) const {
+  const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(q) - static_cast<std::ptrdiff_t>(p);
+  return std::abs(offset) <= kNeighbours && place_ids_[q] == place_ids_[p] + offset;
+}
+
+std::vector<std::pair<int, int>> PlaceWords::CountsOf(std::size_t p) const {
+  std::vector<int> words;
+  const std::size_t first = p - std::min<std::size_t>(p, kNeighbours);
+  const std::size_t last = std::min(p + kNeighbours, place_ids_.size() - 1);
+  for (std::size_t q = first; q <= last; ++q) {
+    if (Neighbours(p, q)) words.insert(words.end(), own_words_[q].begin(), own_words_[q].end());
+  }
+  std::sort(words.begin(), words.end());
+  std::vector<std::pair<int, int>> counts;
+  for (std::size_t begin = 0; begin < words.size();) {
+    std::size_t end = begin;
+    while (end < words.size() && words[end] == words[begin]) ++end;
+    counts.emplace_back(words[begin], static_cast<int>(end - begin));
+    begin = end;
+  }
+  return counts;
+}
+
+void PlaceWords::Weigh() {
+  const std::size_t n_places = place_ids_.size();
+  idf_.assign(postings_.size(), 0.0);
+  norms_.assign(n_places, 0.0);
+  // Word by word: each place's squares are summed in increasing word order.
+  for (std::size_t w = 0; w < postings_.size(); ++w) {
+    if (postings_[w].empty()) continue;
+    idf_[w] = std::log(static_cast<double>(n_places) / static_cast<double>(postings_[w].size()));
+    for (const auto& [place, count] : postings_[w]) {
+      const double weight = count * idf_[w];
+      norms_[static_cast<std::size_t>(place)] += weight * weight;
+    }
+  }
+  for (double& norm : norms_) norm = std::sqrt(norm);
 }
 
 std::vector<int> PlaceWords::WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const {
-  if (descriptors.empty()) return {};
+  if (descriptors.empty() || top_.rows() == 0) return {};  // no vocabulary: a map of no keypoints
   RowMatrixF roots(static_cast<Eigen::Index>(descriptors.size()), kBetaGridBins);
   for (std::size_t k = 0; k < descriptors.size(); ++k) {
     FillRoots(descriptors[k], roots.row(static_cast<Eigen::Index>(k)).data());
@@ -201,7 +240,7 @@ std::vector<int> PlaceWords::WordsOf(const std::vector<BetaGridDescriptor>& desc
 }
 
 std::vector<double> PlaceWords::Similarities(const std::vector<BetaGridDescriptor>& query) const {
-  std::vector<double> similarity(num_places_, 0.0);
+  std::vector<double> similarity(place_ids_.size(), 0.0);
   if (idf_.empty() || query.empty()) return similarity;
   std::vector<int> count(idf_.size(), 0);
   for (const int word : WordsOf(query)) ++count[static_cast<std::size_t>(word)];
@@ -215,8 +254,10 @@ std::vector<double> PlaceWords::Similarities(const std::vector<BetaGridDescripto
   for (std::size_t w = 0; w < count.size(); ++w) {
     if (count[w] == 0 || idf_[w] <= 0.0) continue;
     const double weight = count[w] * idf_[w] / norm;
-    for (const auto& [place, place_weight] : postings_[w]) {
-      similarity[static_cast<std::size_t>(place)] += weight * place_weight;
+    for (const auto& [place, place_count] : postings_[w]) {
+      const double place_norm = norms_[static_cast<std::size_t>(place)];
+      if (place_norm <= 0.0) continue;  // every word of the place is in every place
+      similarity[static_cast<std::size_t>(place)] += weight * (place_count * idf_[w] / place_norm);
     }
   }
   return similarity;

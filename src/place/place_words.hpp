@@ -20,15 +20,21 @@ namespace keyplace {
 class PlaceWords {
  public:
   /// Learns the vocabulary from the places' descriptors (deterministic) and indexes each place:
-  /// O(keypoints x sqrt(words)), which a recognizer that relearns it on every AddPlace pays per
-  /// place.
+  /// O(keypoints x sqrt(words)).
   explicit PlaceWords(const std::vector<Place>& places);
 
+  /// Appends a place described with the vocabulary held (not learned anew): its words join its
+  /// own histogram and those of its map neighbours, and every place is weighed again by the new
+  /// idf, O(its keypoints x sqrt(words) + the map's histogram entries).
+  void Append(const Place& place);
+
   /// The cosine similarity of the query's tf-idf word histogram with each place's, in the order
-  /// of the places given at construction (0 for a place sharing no word).
+  /// of the places given at construction and appended (0 for a place sharing no word).
   std::vector<double> Similarities(const std::vector<BetaGridDescriptor>& query) const;
 
   std::size_t words() const { return idf_.size(); }
+  /// The map keypoints the vocabulary was learned from (those of the places at construction).
+  std::size_t learned_keypoints() const { return learned_keypoints_; }
 
  private:
   using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -37,15 +43,24 @@ class PlaceWords {
   void LearnVocabulary(const RowMatrixF& samples, std::size_t n_words);
   // The word of each descriptor: its nearest leaf under its nearest top centre.
   std::vector<int> WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const;
+  // Whether place q is in the neighbourhood of place p (ids as far apart as their indices).
+  bool Neighbours(std::size_t p, std::size_t q) const;
+  // The word counts of place p's neighbourhood (its own words and its neighbours'), by word.
+  std::vector<std::pair<int, int>> CountsOf(std::size_t p) const;
+  // idf_ and norms_ from postings_.
+  void Weigh();
 
   // A two-level vocabulary: top_ (a centre a row) splits square-root space, leaves_[t] the part of
   // top word t; the words are the leaves, those of top word t numbered from first_word_[t].
   RowMatrixF top_;
   std::vector<RowMatrixF> leaves_;
   std::vector<int> first_word_;
-  std::vector<double> idf_;  // log(places / places holding the word)
-  std::vector<std::vector<std::pair<int, double>>> postings_;  // per word: (place, weight)
-  std::size_t num_places_ = 0;
+  std::size_t learned_keypoints_ = 0;
+  std::vector<int> place_ids_;
+  std::vector<std::vector<int>> own_words_;  // per place: the word of each of its keypoints
+  std::vector<std::vector<std::pair<int, int>>> postings_;  // per word: (place, count)
+  std::vector<double> idf_;    // per word: log(places / places holding the word)
+  std::vector<double> norms_;  // per place: the norm of its tf-idf histogram
 };
 
 }  // namespace keyplace

@@ -5,6 +5,8 @@
 
 #include "place/place_words.hpp"
 
+#include <algorithm>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,6 +30,37 @@ PlaceRecognitionConfig WordsConfig(int places) {
   return config;
 }
 
+// The descriptors of places[p - 2 .. p + 2].
+std::vector<BetaGridDescriptor> NeighbourhoodDescriptors(const std::vector<Place>& places,
+                                                         std::size_t p) {
+  std::vector<BetaGridDescriptor> descriptors;
+  for (std::size_t q = p - 2; q <= p + 2; ++q) {
+    descriptors.insert(descriptors.end(), places[q].descriptors.begin(),
+                       places[q].descriptors.end());
+  }
+  return descriptors;
+}
+
+// Places p (from `first` on) whose neighbourhood's descriptors give their histogram exactly
+// (similarity 1) and no other place as similar; returns how many such places were checked.
+int ExpectNeighbourhoodsRetrieveTheirPlace(const PlaceWords& words,
+                                           const std::vector<Place>& places, std::size_t first) {
+  int checked = 0;
+  for (std::size_t p = std::max<std::size_t>(first, 2); p + 2 < places.size(); ++p) {
+    if (places[p + 2].id != places[p - 2].id + 4) continue;  // not five adjacent submaps
+    const std::vector<double> similarity = words.Similarities(NeighbourhoodDescriptors(places, p));
+    EXPECT_EQ(similarity.size(), places.size());
+    if (similarity.size() != places.size()) return checked;
+    EXPECT_NEAR(similarity[p], 1.0, 1e-9) << "place " << p;
+    for (std::size_t q = 0; q < places.size(); ++q) {
+      if (q == p) continue;
+      EXPECT_LT(similarity[q], similarity[p]) << "place " << p << ", other " << q;
+    }
+    ++checked;
+  }
+  return checked;
+}
+
 // A place's words are its own and those of its map neighbours within two ids: the descriptors of
 // those five places give its histogram exactly, and no other place is as similar.
 TEST(PlaceWords, APlaceIsTheMostSimilarToTheDescriptorsOfItsNeighbourhood) {
@@ -38,24 +71,24 @@ TEST(PlaceWords, APlaceIsTheMostSimilarToTheDescriptorsOfItsNeighbourhood) {
   for (const Place& place : places) keypoints += place.descriptors.size();
   // One word per 8 keypoints, give or take the rounding of each top word's share.
   EXPECT_NEAR(static_cast<double>(words.words()), keypoints / 8.0, keypoints / 8.0 * 0.02);
-  int checked = 0;
-  for (std::size_t p = 2; p + 2 < places.size(); ++p) {
-    if (places[p + 2].id != places[p - 2].id + 4) continue;  // not five adjacent submaps
-    std::vector<BetaGridDescriptor> query;
-    for (std::size_t q = p - 2; q <= p + 2; ++q) {
-      query.insert(query.end(), places[q].descriptors.begin(), places[q].descriptors.end());
-    }
-    const std::vector<double> similarity = words.Similarities(query);
-    ASSERT_EQ(similarity.size(), places.size());
-    EXPECT_NEAR(similarity[p], 1.0, 1e-9) << "place " << p;
-    for (std::size_t q = 0; q < places.size(); ++q) {
-      if (q == p) continue;
-      EXPECT_LT(similarity[q], similarity[p]) << "place " << p << ", other " << q;
-    }
-    ++checked;
-  }
-  EXPECT_GT(checked, 30);
+  EXPECT_EQ(words.learned_keypoints(), keypoints);
+  EXPECT_GT(ExpectNeighbourhoodsRetrieveTheirPlace(words, places, 0), 30);
   EXPECT_EQ(words.Similarities({}), std::vector<double>(places.size(), 0.0));
+}
+
+// Appended places (the vocabulary of the first half kept) join their neighbours' histograms and
+// every place is weighed by the idf of the whole map: a neighbourhood still gives its place's
+// histogram exactly, also across the seam between learned and appended places.
+TEST(PlaceWords, AppendedPlacesJoinTheirNeighboursHistogramsAndTheIdf) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  const std::size_t half = places.size() / 2;
+  PlaceWords words(std::vector<Place>(places.begin(), places.begin() + half));
+  const std::size_t learned = words.learned_keypoints();
+  const std::size_t vocabulary = words.words();
+  for (std::size_t p = half; p < places.size(); ++p) words.Append(places[p]);
+  EXPECT_EQ(words.learned_keypoints(), learned);
+  EXPECT_EQ(words.words(), vocabulary);
+  EXPECT_GT(ExpectNeighbourhoodsRetrieveTheirPlace(words, places, half - 2), 30);
 }
 
 TEST(Retrieval, WordsKeepTheRightAnswersOfTheBundledLogAndPairFewPlaces) {
@@ -103,10 +136,12 @@ TEST(Retrieval, RetrievingEveryPlaceIsTheExactPath) {
   }
 }
 
+// A removal learns the vocabulary anew: places added one by one and then one removed retrieve as
+// a recognizer built at once from the places that remain.
 TEST(Retrieval, ChangedPlaceByPlaceItRetrievesAsOneBuiltAtOnce) {
   const std::vector<Place> all = PlacesFromMap(testing::BundledFr079().map);
   const PlaceRecognitionConfig config = WordsConfig(20);
-  // The last places added one by one (each relearns the vocabulary), the rest at construction.
+  // The last places added one by one (appended to the vocabulary held), the rest at construction.
   PlaceRecognizer grown(std::vector<Place>(all.begin(), all.end() - 5), config);
   for (auto it = all.end() - 5; it != all.end(); ++it) grown.AddPlace(*it);
   ASSERT_TRUE(grown.RemovePlace(all[3].id));
@@ -122,6 +157,35 @@ TEST(Retrieval, ChangedPlaceByPlaceItRetrievesAsOneBuiltAtOnce) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     testing::ExpectSameMatch(a[i].match, b[i].match, "query " + std::to_string(i));
   }
+}
+
+// A recognizer grown place by place from one place (as SLAM grows its map) learns its vocabulary
+// anew as the map doubles: it answers the bundled queries as well as one built at once. Kept with
+// the vocabulary of its first place (16 words), it would not.
+TEST(Retrieval, GrownFromOnePlaceItAnswersAsWellAsOneBuiltAtOnce) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  const PlaceRecognitionConfig config = WordsConfig(20);
+  PlaceRecognizer grown({places.front()}, config);
+  for (auto it = places.begin() + 1; it != places.end(); ++it) grown.AddPlace(*it);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(5);
+  const std::vector<LocalizationRecord> a =
+      EvaluateQueries(queries, grown, SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> b =
+      EvaluateQueries(queries, PlaceRecognizer(places, config), SelfMatchRule::kSameScans);
+  ASSERT_EQ(a.size(), b.size());
+  int grown_correct = 0;
+  int at_once_correct = 0;
+  int grown_wrong = 0;
+  int at_once_wrong = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    grown_correct += a[i].correct ? 1 : 0;
+    at_once_correct += b[i].correct ? 1 : 0;
+    grown_wrong += a[i].match.found && !a[i].correct ? 1 : 0;
+    at_once_wrong += b[i].match.found && !b[i].correct ? 1 : 0;
+  }
+  ASSERT_GT(at_once_correct, static_cast<int>(queries.size()) * 8 / 10);
+  EXPECT_GE(grown_correct, at_once_correct - 3);
+  EXPECT_LE(grown_wrong, at_once_wrong + 1);
 }
 
 TEST(Retrieval, PlacesMustBePositive) {

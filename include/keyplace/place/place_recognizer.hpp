@@ -197,8 +197,10 @@ class PlaceRecognizer {
   ~PlaceRecognizer();
 
   /// Appends a place (last in places()) and indexes its descriptors without rebuilding the index:
-  /// every answer is then the one of a recognizer constructed from places() at once. With
-  /// retrieval kWords the vocabulary is learned anew from places() (O(map keypoints x words)).
+  /// with retrieval exact every answer is then the one of a recognizer constructed from places()
+  /// at once. With retrieval kWords the place is described with the vocabulary held, which is
+  /// learned anew from places() (answers as at once) when they hold twice the keypoints it was
+  /// learned from; in between, answers may differ from those of a recognizer built at once.
   /// Throws std::invalid_argument when its positions and descriptors differ in size.
   void AddPlace(Place place);
   /// Removes the first place with this id (later places move up one index); every answer is then
@@ -240,13 +242,15 @@ class PlaceRecognizer {
   void RebuildIndex();
   // The vocabulary and word histograms of places_ (retrieval kWords), learned anew.
   void RebuildWords();
+  // Adds places_.back() to the word histograms, learning the vocabulary anew when due.
+  void AddWordsOfLastPlace();
 
   std::vector<Place> places_;
   PlaceRecognitionConfig config_;
   std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none
   std::vector<std::size_t> slots_;              // index place number of each of places_
   std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
-  std::shared_ptr<const PlaceWords> words_;     // null for retrieval exact
+  std::shared_ptr<PlaceWords> words_;           // null for retrieval exact
 };
 
 }  // namespace keyplace
