@@ -58,6 +58,8 @@ ResultFields<SlamRun> MakeSlamRunFields() {
   table.Add("loops_detected", "", "loops place recognition found (accepted or not)",
             [](const SlamRun& run) -> ResultValue { return CountValue(run.slam->loops().size()); });
   AddStatsCount(table, "loops_accepted", &SlamStats::loops_accepted, "loops that passed the gate");
+  AddStatsCount(table, "loops_deferred", &SlamStats::loops_deferred,
+                "of those, loops the estimate already met within their sigmas (optimised later)");
   AddStatsCount(table, "loops_refined", &SlamStats::loops_refined,
                 "loop transforms refined by ICP");
   AddStatsCount(table, "loops_partner_changed", &SlamStats::loops_partner_changed,

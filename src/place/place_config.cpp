@@ -66,9 +66,12 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
               "how descriptor pairs are found (same pairs): exhaustive chi2 (none), or a "
               "square-root bound searched by a kd-tree (kdtree) or a matrix product (dense)")
         .Enum("retrieval", &C::retrieval,
-              {{C::Retrieval::kExact, "exact"}, {C::Retrieval::kWords, "words"}},
-              "places paired with a query: every one (exact), or the retrieval_places most "
-              "similar by a vocabulary of descriptors learned from the map (words)")
+              {{C::Retrieval::kAuto, "auto"},
+               {C::Retrieval::kExact, "exact"},
+               {C::Retrieval::kWords, "words"}},
+              "places paired with a query: every one (exact), the retrieval_places most similar "
+              "by a vocabulary of descriptors learned from the map (words), or words for SLAM's "
+              "loop queries and exact elsewhere (auto)")
         .Int("retrieval_places", &C::retrieval_places, "", "words: places paired with a query")
         .Enum("query_keypoints", &C::query_keypoints,
               {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}},
@@ -141,6 +144,7 @@ PlaceRecognitionConfig PaperPlaceConfig() {
   config.min_reference_coverage = 0.0;  // unused: stable query keypoints
   config.dense_min_hit_fraction = 0.0;  // gamma decides, as in the paper
   config.candidate_ranking = PlaceRecognitionConfig::CandidateRanking::kMeanDistance;
+  config.retrieval = PlaceRecognitionConfig::Retrieval::kExact;  // every place, SLAM's too
   return config;
 }
 

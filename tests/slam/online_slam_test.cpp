@@ -107,6 +107,35 @@ TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   }
 }
 
+// A loop the estimate already meets within its sigmas is not optimised at once: it waits in the
+// graph for the next loop that disagrees, or for Finish(). The first loop of the square removes
+// the drift (optimised at once); later loops of the same corners agree with the corrected graph.
+TEST(OnlineSlam, LoopsTheEstimateAlreadyMeetsWaitForTheNextOptimisation) {
+  const SimulatedRun run = Simulate(1.4);
+  const FlirtExtractor extractor;
+  OnlineSlam slam(SimulationConfig());
+  int first_loop_optimized = -1;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    const SlamStep step = slam.AddScan(static_cast<int>(i), run.scans[i],
+                                       run.scans[i].odometry_pose, extractor.Extract(run.scans[i]));
+    if (step.loop >= 0 && first_loop_optimized < 0) first_loop_optimized = step.optimized ? 1 : 0;
+  }
+  const SlamStats before_finish = slam.stats();
+  slam.Finish();
+  const SlamStats& stats = slam.stats();
+  ASSERT_GE(stats.loops_accepted, 3u);
+  EXPECT_EQ(first_loop_optimized, 1);
+  EXPECT_GE(stats.loops_deferred, 1u);
+  // slam.optimize_every_loops 1: one optimisation per loop that was not deferred (+ Finish's).
+  EXPECT_EQ(before_finish.optimizations + before_finish.loops_deferred, stats.loops_accepted);
+  // Every deferred loop is in the final solution, and it still fits it.
+  for (const LoopClosure& loop : slam.loops()) {
+    if (!loop.accepted) continue;
+    EXPECT_TRUE(slam.LoopUsed(loop));
+    EXPECT_LT(slam.graph().WhitenedResidual(loop.edge), 3.0) << "loop " << loop.query_submap;
+  }
+}
+
 // Issue 17: with slam.all_scan_loop_queries (the default) the loop detector queries with the
 // keypoints of all the submap's scans, as `keyplace localize` does. With gamma_min 1 for
 // stable-keypoint queries no loop can pass the stable query's gamma check; the all-scan query is

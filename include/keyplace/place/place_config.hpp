@@ -39,9 +39,11 @@ struct PlaceRecognitionConfig {
   DescriptorIndex descriptor_index = DescriptorIndex::kDense;
   // Which places a query is paired with. kExact: every place (the oracle). kWords: the
   // retrieval_places places whose word histograms (a vocabulary of descriptors learned from the
-  // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval").
-  enum class Retrieval { kExact, kWords };
-  Retrieval retrieval = Retrieval::kExact;
+  // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval"). kAuto:
+  // kWords for SLAM's loop queries (a loop one submap's query misses, the next submaps' find),
+  // kExact wherever else (one query, one answer: PlaceRecognizer takes kAuto as kExact).
+  enum class Retrieval { kAuto, kExact, kWords };
+  Retrieval retrieval = Retrieval::kAuto;
   int retrieval_places = 50;
   // Which query keypoints go through pairing and RANSAC. kStable: the query submap's stable
   // keypoints (the paper). kAllScans: every keypoint of every scan of the query submap, in the

@@ -128,7 +128,10 @@ struct SlamStats {
   std::size_t submaps = 0;
   std::size_t queries = 0;  // completed submaps matched against the map (eligible places > 0)
   std::size_t loops_detected = 0;
-  std::size_t loops_accepted = 0;         // passed the gate
+  std::size_t loops_accepted = 0;  // passed the gate
+  // Of those, loops the estimate already met within their sigmas when accepted: optimised with
+  // the next loop that does not, or in Finish(), not at once.
+  std::size_t loops_deferred = 0;
   std::size_t loops_refined = 0;          // loop transform refined by ICP
   std::size_t loops_partner_changed = 0;  // partner is a neighbour of the matched submap
   // Found matches not taken as loops by the point-overlap verification
