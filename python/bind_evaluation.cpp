@@ -239,7 +239,7 @@ py::tuple Slam(const std::string& log_path, const py::object& config, const py::
     }
     std::optional<std::vector<Relation>> relation_list;
     if (!relations_path.empty()) relation_list = ReadRelations(relations_path);
-    *run = RunSlamOnLog(inputs, ToSlamConfig(resolved), processing_order);
+    *run = RunSlamOnLog(inputs, ToSlamConfig(resolved), resolved.features, processing_order);
     run->map.configuration = ConfigToYaml(resolved);
     *evaluation = EvaluateSlam(*run, ground_truth ? &*ground_truth : nullptr,
                                relation_list ? &*relation_list : nullptr, resolved.evaluation);

@@ -44,16 +44,17 @@ struct SlamOptions {
   ConfigOptions config;
 };
 
-// The log's scans and keypoints; SLAM estimates the poses itself.
+// The log's scans; SLAM estimates the poses itself, and the keypoints are extracted beside it.
 LogInputs PrepareInputs(const std::string& path, const Config& config) {
   LogInputOptions options = LogInputOptionsFor(config);
   options.compute_poses = false;
+  options.keypoints = false;
   return PrepareLogInputs(path, options, StageProgressBar());
 }
 
 SlamRun Run(const LogInputs& inputs, const Config& config, ProcessingOrder order) {
   Progress progress("slam", inputs.log.scans.size());
-  SlamRun run = RunSlamOnLog(inputs, ToSlamConfig(config), order,
+  SlamRun run = RunSlamOnLog(inputs, ToSlamConfig(config), config.features, order,
                              [&](std::size_t done, std::size_t) { progress.Update(done); });
   progress.Finish();
   run.map.configuration = ConfigToYaml(config);

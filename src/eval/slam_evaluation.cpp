@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "common/seconds_since.hpp"
 #include "keyplace/io/timestamps.hpp"
+#include "mapping/keypoint_stream.hpp"
 
 namespace keyplace {
 namespace {
@@ -118,10 +120,10 @@ std::vector<std::size_t> SlamRpeDeltas() {
   return {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000};
 }
 
-SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, ProcessingOrder order,
-                     const ProgressCallback& progress) {
+SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, const FlirtConfig& features,
+                     ProcessingOrder order, const ProgressCallback& progress) {
   const std::vector<LogScan>& scans = inputs.log.scans;
-  if (inputs.keypoints.size() != scans.size()) {
+  if (!inputs.keypoints.empty() && inputs.keypoints.size() != scans.size()) {
     throw std::invalid_argument("RunSlamOnLog: " + std::to_string(inputs.keypoints.size()) +
                                 " keypoint lists for the " + std::to_string(scans.size()) +
                                 " scans of " + inputs.log.path);
@@ -137,13 +139,20 @@ SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, Processi
   run.seconds_keypoints = inputs.seconds_keypoints;
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::size_t> sequence = ProcessingSequence(scans, order);
+  std::optional<KeypointStream> stream;
+  if (inputs.keypoints.empty()) stream.emplace(inputs.log, sequence, features);
   for (std::size_t k = 0; k < sequence.size(); ++k) {
     const std::size_t i = sequence[k];
-    run.slam->AddScan(static_cast<int>(i), scans[i], scans[i].odometry_pose, inputs.keypoints[i]);
+    run.slam->AddScan(static_cast<int>(i), scans[i], scans[i].odometry_pose,
+                      stream ? stream->Wait(k) : inputs.keypoints[i]);
     if (progress) progress(k + 1, sequence.size());
   }
   run.slam->Finish();
   run.seconds_slam = SecondsSince(start);
+  if (stream) {
+    run.seconds_keypoints = stream->seconds();
+    run.keypoints_beside_slam = true;
+  }
   run.map = run.slam->map();
   run.map.source_log = inputs.source_log;
   run.map.source_hash = inputs.source_hash;
@@ -189,9 +198,11 @@ SlamEvaluation EvaluateSlam(const SlamRun& run, const GroundTruth* truth,
   ev.loops_below_1_percent = static_cast<std::size_t>(std::count_if(
       ev.loops.overlap.begin(), ev.loops.overlap.end(), [](double o) { return o < 0.01; }));
   ev.mapping = ComputeStats(run.map);
-  ev.seconds_per_submap = ev.mapping.submaps > 0
-                              ? (run.seconds_keypoints + run.seconds_slam) / ev.mapping.submaps
-                              : 0.0;
+  // Keypoints extracted beside SLAM took their time within seconds_slam.
+  const double seconds =
+      run.seconds_slam + (run.keypoints_beside_slam ? 0.0 : run.seconds_keypoints);
+  ev.seconds_per_submap =
+      ev.mapping.submaps > 0 ? seconds / static_cast<double>(ev.mapping.submaps) : 0.0;
   if (truth != nullptr) {
     ev.accuracy = Accuracy(run, *truth, ev.loops, ev.figure);
   } else {

@@ -78,7 +78,8 @@ SimulatedRelations RelationsOf(const testing::SimulatedRun& run) {
 TEST(SlamEvaluation, SquareLoopRunAgainstItsTruth) {
   const testing::SimulatedRun sim = testing::Simulate(1.4);
   const LogInputs inputs = InputsOf(sim);
-  const SlamRun run = RunSlamOnLog(inputs, testing::SimulationConfig(), ProcessingOrder::kLogger);
+  const SlamRun run =
+      RunSlamOnLog(inputs, testing::SimulationConfig(), FlirtConfig{}, ProcessingOrder::kLogger);
   ASSERT_NE(run.slam, nullptr);
   EXPECT_EQ(run.scans, sim.scans.size());
   EXPECT_EQ(run.trajectory.size(), sim.scans.size());
@@ -160,7 +161,7 @@ TEST(SlamEvaluation, RunFollowsTheProcessingOrder) {
   }
   const LogInputs inputs = InputsOf(sim);
   for (ProcessingOrder order : {ProcessingOrder::kLogger, ProcessingOrder::kFile}) {
-    const SlamRun run = RunSlamOnLog(inputs, testing::SimulationConfig(), order);
+    const SlamRun run = RunSlamOnLog(inputs, testing::SimulationConfig(), FlirtConfig{}, order);
     const std::vector<std::size_t> sequence = ProcessingSequence(inputs.log.scans, order);
     ASSERT_EQ(run.trajectory.size(), sequence.size());
     for (std::size_t k = 0; k < sequence.size(); ++k) {
@@ -171,17 +172,53 @@ TEST(SlamEvaluation, RunFollowsTheProcessingOrder) {
   }
   // Progress after every scan; keypoints missing for the scans are misuse.
   std::vector<std::size_t> done;
-  RunSlamOnLog(inputs, testing::SimulationConfig(), ProcessingOrder::kFile,
+  RunSlamOnLog(inputs, testing::SimulationConfig(), FlirtConfig{}, ProcessingOrder::kFile,
                [&](std::size_t d, std::size_t total) {
                  EXPECT_EQ(total, 30u);
                  done.push_back(d);
                });
   ASSERT_EQ(done.size(), 30u);
   EXPECT_EQ(done.back(), 30u);
-  LogInputs no_keypoints = inputs;
-  no_keypoints.keypoints.clear();
-  EXPECT_THROW(RunSlamOnLog(no_keypoints, testing::SimulationConfig(), ProcessingOrder::kFile),
+  LogInputs too_few_keypoints = inputs;
+  too_few_keypoints.keypoints.pop_back();
+  EXPECT_THROW(RunSlamOnLog(too_few_keypoints, testing::SimulationConfig(), FlirtConfig{},
+                            ProcessingOrder::kFile),
                std::invalid_argument);
+}
+
+// Without keypoints in the inputs they are extracted beside SLAM, in its order: the run is the
+// one with the same keypoints given, pose for pose and loop for loop.
+TEST(SlamEvaluation, KeypointsExtractedBesideSlamGiveTheSameRun) {
+  testing::SimulatedRun sim = testing::Simulate(1.4);
+  // Logger order differs from file order (the first 40 scans come last).
+  for (std::size_t i = 0; i < sim.scans.size(); ++i) {
+    sim.scans[i].logger_timestamp_s = static_cast<double>(i < 40 ? i + 10000 : i);
+  }
+  LogInputs given = InputsOf(sim);
+  given.keypoints = ExtractKeypoints(given.log, FlirtExtractor(), {});
+  LogInputs beside = given;
+  beside.keypoints.clear();
+  const SlamRun a =
+      RunSlamOnLog(given, testing::SimulationConfig(), FlirtConfig{}, ProcessingOrder::kLogger);
+  const SlamRun b =
+      RunSlamOnLog(beside, testing::SimulationConfig(), FlirtConfig{}, ProcessingOrder::kLogger);
+  EXPECT_FALSE(a.keypoints_beside_slam);
+  EXPECT_TRUE(b.keypoints_beside_slam);
+  EXPECT_GT(b.seconds_keypoints, 0.0);
+  EXPECT_LE(b.seconds_keypoints, b.seconds_slam);
+  ASSERT_GE(a.slam->loops().size(), 1u);
+  ASSERT_EQ(b.slam->loops().size(), a.slam->loops().size());
+  ASSERT_EQ(b.trajectory.size(), a.trajectory.size());
+  for (std::size_t k = 0; k < a.trajectory.size(); ++k) {
+    EXPECT_EQ(b.trajectory[k].scan_index, a.trajectory[k].scan_index) << k;
+    EXPECT_EQ(b.trajectory[k].T_world_robot.x, a.trajectory[k].T_world_robot.x) << k;
+    EXPECT_EQ(b.trajectory[k].T_world_robot.theta, a.trajectory[k].T_world_robot.theta) << k;
+  }
+  // A scan whose keypoints cannot be extracted fails the run with the extraction's error.
+  beside.log.scans[50].ranges_m.pop_back();
+  EXPECT_THROW(
+      RunSlamOnLog(beside, testing::SimulationConfig(), FlirtConfig{}, ProcessingOrder::kFile),
+      std::invalid_argument);
 }
 
 }  // namespace

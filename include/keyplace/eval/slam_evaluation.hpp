@@ -49,17 +49,22 @@ struct SlamRun {
   GlobalMap map;
   std::vector<OnlineSlam::ScanPose> trajectory;  // slam->Trajectory(): processing order
   ProcessingOrder order = ProcessingOrder::kLogger;
-  std::size_t scans = 0;           // scans of the log given to SLAM
-  double seconds_keypoints = 0.0;  // LogInputs::seconds_keypoints
-  double seconds_slam = 0.0;       // AddScan of every scan and Finish
+  std::size_t scans = 0;  // scans of the log given to SLAM
+  // LogInputs::seconds_keypoints, or with keypoints_beside_slam the extraction's wall time, spent
+  // while SLAM ran (part of seconds_slam then).
+  double seconds_keypoints = 0.0;
+  bool keypoints_beside_slam = false;
+  double seconds_slam = 0.0;  // AddScan of every scan and Finish
 };
 
 /// Runs OnlineSlam over every scan of `inputs` (scan_index = index into inputs.log.scans; the
-/// odometry pose of the log, inputs.keypoints) in `order`, then Finish(). `progress` (done,
-/// total) is called after each scan. Throws std::invalid_argument when the config is invalid or
-/// the inputs hold no keypoints for their scans.
-SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, ProcessingOrder order,
-                     const ProgressCallback& progress = {});
+/// odometry pose of the log, inputs.keypoints) in `order`, then Finish(). With inputs.keypoints
+/// empty the keypoints are extracted (FLIRT with `features`) on threads of their own while SLAM
+/// runs, ahead of it in `order`: the same run, in the time of the slower of the two instead of
+/// their sum. `progress` (done, total) is called after each scan. Throws std::invalid_argument
+/// when the config is invalid or the inputs hold keypoints for other scans than theirs.
+SlamRun RunSlamOnLog(const LogInputs& inputs, const SlamConfig& config, const FlirtConfig& features,
+                     ProcessingOrder order, const ProgressCallback& progress = {});
 
 /// The occupancy grid of the scans of `inputs` at the SLAM trajectory's final poses (`run` made
 /// from `inputs`). Throws std::invalid_argument as BuildOccupancyGrid.
