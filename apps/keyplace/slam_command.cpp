@@ -85,10 +85,21 @@ void RunSlam(const CLI::App& command, const SlamOptions& options) {
   if (!options.relations_path.empty()) relations = ReadRelations(options.relations_path);
 
   const SlamRun run = Run(inputs, config, order);
-  // Built before anything is written: a grid that cannot be made (grid.max_cells) leaves no
-  // output of this run behind.
+  // The grid: written with --grid, and with --truth checked against the grid at the corrected
+  // poses (a map locally right but globally bent shows there, not in the relation errors). Built
+  // before anything is written: a grid --grid asks for that cannot be made (grid.max_cells)
+  // leaves no output of this run behind; the check alone only notes it.
   std::optional<OccupancyGrid> grid;
-  if (!options.grid_path.empty()) grid = SlamOccupancyGrid(run, inputs, config.grid);
+  std::string grid_note;
+  if (!options.grid_path.empty()) {
+    grid = SlamOccupancyGrid(run, inputs, config.grid);
+  } else if (truth) {
+    try {
+      grid = SlamOccupancyGrid(run, inputs, config.grid);
+    } catch (const std::invalid_argument& error) {
+      grid_note = error.what();
+    }
+  }
   if (!options.out_path.empty()) SaveMap(run.map, options.out_path);
   if (!options.trajectory_path.empty()) {
     if (ParseTrajectoryFormat(options.trajectory_format) == TrajectoryFormat::kTum) {
@@ -112,14 +123,14 @@ void RunSlam(const CLI::App& command, const SlamOptions& options) {
     fmt::print("figures written to {}\n", options.figures_dir);
   }
   if (!options.out_path.empty()) fmt::print("map written to {}\n", options.out_path);
+  if (grid && !options.grid_path.empty()) WriteGrid(options.grid_path, *grid, config.grid);
   std::optional<GridAgreement> grid_agreement;
-  if (grid) {
-    WriteGrid(options.grid_path, *grid, config.grid);
-    if (truth && evaluation.accuracy) {
-      grid_agreement = EvaluateSlamGrid(*grid, inputs, *truth, *evaluation.accuracy, config.grid,
-                                        config.evaluation.grid_tolerance_m);
-      PrintGridAgreement(*grid_agreement);
-    }
+  if (grid && truth && evaluation.accuracy) {
+    grid_agreement = EvaluateSlamGrid(*grid, inputs, *truth, *evaluation.accuracy, config.grid,
+                                      config.evaluation.grid_tolerance_m);
+    PrintGridAgreement(*grid_agreement);
+  } else if (!grid_note.empty()) {
+    fmt::print("grid agreement     not computed: {}\n", grid_note);
   }
   if (!options.json_path.empty()) {
     nlohmann::json json = SlamJson(report, SecondsSince(start));
@@ -148,8 +159,7 @@ void RegisterSlamCommand(CLI::App& app) {
   command->add_option("--out", options->out_path, "write the SLAM map (.kpm)");
   command->add_option("--grid", options->grid_path,
                       "write an occupancy grid of the scans at the SLAM poses for ROS map_server "
-                      "/ nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE); with "
-                      "--truth it is checked against the grid at the corrected poses");
+                      "/ nav2 (FILE.yaml and FILE.pgm; settings: --set grid.KEY=VALUE)");
   command->add_option("--trajectory", options->trajectory_path,
                       "write every scan's optimised pose (TSV: scan_index, timestamp, x, y, theta, "
                       "submap, ICP pose; or TUM with --trajectory-format tum)");
@@ -159,7 +169,10 @@ void RegisterSlamCommand(CLI::App& app) {
                    "qx qy qz qw, as evo reads it)")
       ->check(CLI::IsMember({"tsv", "tum"}))
       ->capture_default_str();
-  command->add_option("--truth", options->truth_path, "corrected log for ATE / RPE (needs --index)")
+  command
+      ->add_option("--truth", options->truth_path,
+                   "corrected log for ATE / RPE and the grid check: the SLAM grid against the "
+                   "grid at the corrected poses (needs --index)")
       ->check(CLI::ExistingFile);
   command->add_option("--index", options->index_path, "raw_index corrected_index TSV")
       ->check(CLI::ExistingFile);

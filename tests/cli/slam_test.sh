@@ -75,6 +75,19 @@ assert g['tolerance_m'] == 0.1 and g['occupied'] > 1000 and g['occupied_referenc
 assert g['occupied_matched'] > 0.85 and g['reference_matched'] > 0.85, g
 assert g['occupied_on_free'] < 0.05, g
 " "$work"
+# With --truth the grid is checked without --grid too (issue 34: the global-consistency check
+# beside the relation errors), with the same figures, and no grid file is written.
+check "grid check without --grid" "$keyplace" slam "$raw" \
+  --truth "$shared/data/fr079-corrected.log.gz" --index "$work/index.tsv" \
+  --json "$work/slam-check.json"
+cp "$work/out" "$work/check.out"
+check "grid check printed" grep -q "^grid vs corrected-pose grid: " "$work/check.out"
+check "grid check as with --grid" python3 -c "
+import json,sys
+a = json.load(open(sys.argv[1]))['grid_agreement']
+b = json.load(open(sys.argv[2]))['grid_agreement']
+assert a == b, (a, b)
+" "$work/slam.json" "$work/slam-check.json"
 fails_with "--grid equal to --out" "--grid" "$keyplace" slam "$raw" --out "$work/same.yaml" \
   --grid "$work/same.yaml"
 fails_with "grid config checked" "grid.free_thresh" "$keyplace" slam "$raw" \
