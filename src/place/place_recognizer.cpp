@@ -298,6 +298,8 @@ void PlaceRecognizer::RebuildIndex() {
   slots_.clear();
   removed_keypoints_ = 0;
   if (config_.descriptor_index == PlaceRecognitionConfig::DescriptorIndex::kNone) return;
+  // Retrieval indexes the places it retrieves for each query instead (recognition.cpp).
+  if (config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords) return;
   index_ = std::make_shared<SqrtDescriptorIndex>(places_, config_.descriptor_index);
   for (std::size_t p = 0; p < places_.size(); ++p) slots_.push_back(p);
 }
@@ -309,7 +311,7 @@ void PlaceRecognizer::AddPlace(Place place) {
   }
   places_.push_back(std::move(place));
   AddWordsOfLastPlace();
-  if (!index_) return;  // kNone
+  if (!index_) return;  // descriptor_index none, or retrieval words
   if (index_.use_count() > 1) {
     RebuildIndex();  // a copy shares the index: never change it under the copy
     return;
@@ -325,7 +327,7 @@ bool PlaceRecognizer::RemovePlace(int place_id) {
   removed_keypoints_ += it->descriptors.size();
   places_.erase(it);
   RebuildWords();
-  if (!index_) return true;  // kNone
+  if (!index_) return true;  // descriptor_index none, or retrieval words
   slots_.erase(slots_.begin() + static_cast<std::ptrdiff_t>(p));
   // The removed keypoints stay indexed (never searched: Recognize searches the slots of places_)
   // until they are the majority, so rebuilding costs O(1) amortised per removed keypoint.

@@ -206,17 +206,17 @@ std::vector<std::pair<int, int>> PlaceWords::CountsOf(std::size_t p) const {
 void PlaceWords::Weigh() {
   const std::size_t n_places = place_ids_.size();
   idf_.assign(postings_.size(), 0.0);
-  norms_.assign(n_places, 0.0);
+  inverse_norms_.assign(n_places, 0.0);
   // Word by word: each place's squares are summed in increasing word order.
   for (std::size_t w = 0; w < postings_.size(); ++w) {
     if (postings_[w].empty()) continue;
     idf_[w] = std::log(static_cast<double>(n_places) / static_cast<double>(postings_[w].size()));
     for (const auto& [place, count] : postings_[w]) {
       const double weight = count * idf_[w];
-      norms_[static_cast<std::size_t>(place)] += weight * weight;
+      inverse_norms_[static_cast<std::size_t>(place)] += weight * weight;
     }
   }
-  for (double& norm : norms_) norm = std::sqrt(norm);
+  for (double& norm : inverse_norms_) norm = norm > 0.0 ? 1.0 / std::sqrt(norm) : 0.0;
 }
 
 std::vector<int> PlaceWords::WordsOf(const std::vector<BetaGridDescriptor>& descriptors) const {
@@ -253,11 +253,11 @@ std::vector<double> PlaceWords::Similarities(const std::vector<BetaGridDescripto
   const double norm = std::sqrt(norm2);
   for (std::size_t w = 0; w < count.size(); ++w) {
     if (count[w] == 0 || idf_[w] <= 0.0) continue;
-    const double weight = count[w] * idf_[w] / norm;
+    // The query's weight times the word's idf; a place holding the word (idf > 0) has a norm > 0.
+    const double factor = count[w] * idf_[w] / norm * idf_[w];
     for (const auto& [place, place_count] : postings_[w]) {
-      const double place_norm = norms_[static_cast<std::size_t>(place)];
-      if (place_norm <= 0.0) continue;  // every word of the place is in every place
-      similarity[static_cast<std::size_t>(place)] += weight * (place_count * idf_[w] / place_norm);
+      const auto p = static_cast<std::size_t>(place);
+      similarity[p] += factor * place_count * inverse_norms_[p];
     }
   }
   return similarity;

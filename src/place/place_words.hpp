@@ -47,7 +47,7 @@ class PlaceWords {
   bool Neighbours(std::size_t p, std::size_t q) const;
   // The word counts of place p's neighbourhood (its own words and its neighbours'), by word.
   std::vector<std::pair<int, int>> CountsOf(std::size_t p) const;
-  // idf_ and norms_ from postings_.
+  // idf_ and inverse_norms_ from postings_.
   void Weigh();
 
   // A two-level vocabulary: top_ (a centre a row) splits square-root space, leaves_[t] the part of
@@ -59,8 +59,8 @@ class PlaceWords {
   std::vector<int> place_ids_;
   std::vector<std::vector<int>> own_words_;  // per place: the word of each of its keypoints
   std::vector<std::vector<std::pair<int, int>>> postings_;  // per word: (place, count)
-  std::vector<double> idf_;    // per word: log(places / places holding the word)
-  std::vector<double> norms_;  // per place: the norm of its tf-idf histogram
+  std::vector<double> idf_;            // per word: log(places / places holding the word)
+  std::vector<double> inverse_norms_;  // per place: 1 / the norm of its tf-idf histogram (or 0)
 };
 
 }  // namespace keyplace

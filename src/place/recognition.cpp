@@ -146,9 +146,23 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
   // The index finds, per place, the pairs below the threshold that the exhaustive loop of
   // MatchDescriptorPairs finds, in its order and with its distances.
   std::vector<std::vector<DescriptorPair>> below;  // by index slot
+  std::vector<std::size_t> slot_of = slots;        // index slot of each place
+  // Retrieval pairs a few places: they get a dense index of their own for this query (the same
+  // pairs as any index), so that the recognizer keeps none over the whole map.
+  std::optional<SqrtDescriptorIndex> retrieved;
+  if (words && config.descriptor_index != PlaceRecognitionConfig::DescriptorIndex::kNone) {
+    retrieved.emplace(std::vector<Place>{}, PlaceRecognitionConfig::DescriptorIndex::kDense);
+    slot_of.assign(places.size(), 0);
+    for (std::size_t p = 0; p < places.size(); ++p) {
+      if (searched[p]) slot_of[p] = retrieved->AddPlace(places[p].descriptors);
+    }
+    index = &*retrieved;
+  }
   if (index) {
     std::vector<char> searched_slots(index->places(), 0);
-    for (std::size_t p = 0; p < places.size(); ++p) searched_slots[slots[p]] = searched[p];
+    for (std::size_t p = 0; p < places.size(); ++p) {
+      if (searched[p]) searched_slots[slot_of[p]] = 1;
+    }
     index->FindPairs(query, config.descriptor_match_chi2, searched_slots, below);
   }
   tbb::parallel_for(
@@ -158,7 +172,7 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
           if (!searched[p]) continue;
           const Place& place = places[p];
           std::vector<DescriptorPair> pairs =
-              index ? UniquePairs(std::move(below[slots[p]]), query.size(),
+              index ? UniquePairs(std::move(below[slot_of[p]]), query.size(),
                                   place.descriptors.size(), config.pair_matching)
                     : MatchDescriptorPairs(query, place.descriptors, config.descriptor_match_chi2,
                                            config.pair_matching);
