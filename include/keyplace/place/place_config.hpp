@@ -41,7 +41,8 @@ struct PlaceRecognitionConfig {
   // retrieval_places places whose word histograms (a vocabulary of descriptors learned from the
   // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval"). kAuto:
   // kWords for SLAM's loop queries (a loop one submap's query misses, the next submaps' find),
-  // kExact wherever else (one query, one answer: PlaceRecognizer takes kAuto as kExact).
+  // kExact wherever else (PlaceRecognizer takes kAuto as kExact): a single query's miss is a lost
+  // answer, and the Relocalizer fixed fewer starts with kWords (docs/notes/retrieval.md).
   enum class Retrieval { kAuto, kExact, kWords };
   Retrieval retrieval = Retrieval::kAuto;
   int retrieval_places = 50;
