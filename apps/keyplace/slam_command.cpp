@@ -61,6 +61,57 @@ SlamRun Run(const LogInputs& inputs, const Config& config, ProcessingOrder order
   return run;
 }
 
+// The grid at the SLAM poses, for --grid and for the check against the corrected poses (a map
+// locally right but globally bent shows there, not in the relation errors). A grid --grid asks
+// for that cannot be made (grid.max_cells) throws, before any output of the run is written; when
+// only the check wanted it, `note` says why there is none.
+std::optional<OccupancyGrid> SlamGrid(const SlamRun& run, const LogInputs& inputs,
+                                      const Config& config, bool written, bool checked,
+                                      std::string& note) {
+  if (written) return SlamOccupancyGrid(run, inputs, config.grid);
+  if (!checked) return std::nullopt;
+  try {
+    return SlamOccupancyGrid(run, inputs, config.grid);
+  } catch (const std::invalid_argument& error) {
+    note = error.what();
+    return std::nullopt;
+  }
+}
+
+// The grid check, printed; none (and a note printed) when a grid could not be made.
+std::optional<GridAgreement> CheckGrid(const std::optional<OccupancyGrid>& grid,
+                                       const LogInputs& inputs, const GroundTruth& truth,
+                                       const SlamEvaluation& evaluation, const Config& config,
+                                       std::string note) {
+  std::optional<GridAgreement> agreement;
+  if (grid && evaluation.accuracy) {
+    try {
+      agreement = EvaluateSlamGrid(*grid, inputs, truth, *evaluation.accuracy, config.grid,
+                                   config.evaluation.grid_tolerance_m);
+    } catch (const std::invalid_argument& error) {  // the corrected-pose grid (grid.max_cells)
+      note = error.what();
+    }
+  }
+  if (agreement) {
+    PrintGridAgreement(*agreement);
+  } else if (!note.empty()) {
+    fmt::print("grid agreement     not computed: {}\n", note);
+  }
+  return agreement;
+}
+
+void WriteTrajectory(const SlamOptions& options, const SlamRun& run) {
+  if (ParseTrajectoryFormat(options.trajectory_format) == TrajectoryFormat::kTum) {
+    std::vector<TrajectoryPose> poses;
+    for (const OnlineSlam::ScanPose& pose : run.trajectory) {
+      poses.push_back({pose.timestamp_s, pose.T_world_robot});
+    }
+    WriteTumTrajectory(options.trajectory_path, poses);
+  } else {
+    WriteTrajectoryTsv(options.trajectory_path, run);
+  }
+}
+
 void RunSlam(const CLI::App& command, const SlamOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (options.truth_path.empty() != options.index_path.empty()) {
@@ -85,33 +136,11 @@ void RunSlam(const CLI::App& command, const SlamOptions& options) {
   if (!options.relations_path.empty()) relations = ReadRelations(options.relations_path);
 
   const SlamRun run = Run(inputs, config, order);
-  // The grid: written with --grid, and with --truth checked against the grid at the corrected
-  // poses (a map locally right but globally bent shows there, not in the relation errors). Built
-  // before anything is written: a grid --grid asks for that cannot be made (grid.max_cells)
-  // leaves no output of this run behind; the check alone only notes it.
-  std::optional<OccupancyGrid> grid;
   std::string grid_note;
-  if (!options.grid_path.empty()) {
-    grid = SlamOccupancyGrid(run, inputs, config.grid);
-  } else if (truth) {
-    try {
-      grid = SlamOccupancyGrid(run, inputs, config.grid);
-    } catch (const std::invalid_argument& error) {
-      grid_note = error.what();
-    }
-  }
+  const std::optional<OccupancyGrid> grid =
+      SlamGrid(run, inputs, config, !options.grid_path.empty(), truth.has_value(), grid_note);
   if (!options.out_path.empty()) SaveMap(run.map, options.out_path);
-  if (!options.trajectory_path.empty()) {
-    if (ParseTrajectoryFormat(options.trajectory_format) == TrajectoryFormat::kTum) {
-      std::vector<TrajectoryPose> poses;
-      for (const OnlineSlam::ScanPose& pose : run.trajectory) {
-        poses.push_back({pose.timestamp_s, pose.T_world_robot});
-      }
-      WriteTumTrajectory(options.trajectory_path, poses);
-    } else {
-      WriteTrajectoryTsv(options.trajectory_path, run);
-    }
-  }
+  if (!options.trajectory_path.empty()) WriteTrajectory(options, run);
   const SlamEvaluation evaluation = EvaluateSlam(
       run, truth ? &*truth : nullptr, relations ? &*relations : nullptr, config.evaluation);
   if (!options.loops_path.empty()) WriteLoopsTsv(options.loops_path, run, evaluation.loops);
@@ -125,13 +154,7 @@ void RunSlam(const CLI::App& command, const SlamOptions& options) {
   if (!options.out_path.empty()) fmt::print("map written to {}\n", options.out_path);
   if (grid && !options.grid_path.empty()) WriteGrid(options.grid_path, *grid, config.grid);
   std::optional<GridAgreement> grid_agreement;
-  if (grid && truth && evaluation.accuracy) {
-    grid_agreement = EvaluateSlamGrid(*grid, inputs, *truth, *evaluation.accuracy, config.grid,
-                                      config.evaluation.grid_tolerance_m);
-    PrintGridAgreement(*grid_agreement);
-  } else if (!grid_note.empty()) {
-    fmt::print("grid agreement     not computed: {}\n", grid_note);
-  }
+  if (truth) grid_agreement = CheckGrid(grid, inputs, *truth, evaluation, config, grid_note);
   if (!options.json_path.empty()) {
     nlohmann::json json = SlamJson(report, SecondsSince(start));
     if (grid_agreement) json["grid_agreement"] = GridAgreementJson(*grid_agreement);

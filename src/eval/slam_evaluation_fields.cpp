@@ -71,7 +71,8 @@ ResultFields<SlamRun> MakeSlamRunFields() {
   AddStatsCount(table, "ceres_solves", &SlamStats::solves, "Ceres solves of those");
   table
       .Number("seconds_keypoints", &SlamRun::seconds_keypoints, "s",
-              "FLIRT keypoints of every scan")
+              "FLIRT keypoints of every scan, before SLAM or (keyplace slam) while it ran, "
+              "within seconds_slam")
       .Number("seconds_slam", &SlamRun::seconds_slam, "s", "AddScan of every scan and Finish");
   AddStatsSeconds(table, "seconds_odometry", &SlamStats::seconds_odometry, "... of which ICP");
   AddStatsSeconds(table, "seconds_mapping", &SlamStats::seconds_mapping, "... submaps");

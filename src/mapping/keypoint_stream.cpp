@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <utility>
+#include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -60,16 +61,14 @@ void KeypointStream::Run() {
 }
 
 const std::vector<Keypoint>& KeypointStream::Wait(std::size_t k) {
+  if (k >= order_.size()) {
+    throw std::out_of_range("KeypointStream::Wait: scan " + std::to_string(k) + " of " +
+                            std::to_string(order_.size()));
+  }
   std::unique_lock<std::mutex> lock(mutex_);
   ready_changed_.wait(lock, [&] { return ready_ > k || error_; });
   if (ready_ <= k) std::rethrow_exception(error_);
   return keypoints_[order_.at(k)];
-}
-
-std::vector<std::vector<Keypoint>> KeypointStream::TakeAll() {
-  if (!order_.empty()) Wait(order_.size() - 1);
-  const std::lock_guard<std::mutex> lock(mutex_);
-  return std::move(keypoints_);
 }
 
 double KeypointStream::seconds() const {

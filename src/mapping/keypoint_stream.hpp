@@ -1,8 +1,8 @@
 #pragma once
 // Keypoints extracted ahead of their consumer: a thread of its own extracts the keypoints of a
-// log's scans in a given order, a batch at a time (the scans of a batch in parallel), while the
-// consumer (SLAM, one scan at a time) takes them as they become ready. On two cores SLAM then
-// runs beside the extraction instead of after it.
+// log's scans in a given order, a batch at a time (the scans of a batch in parallel), as far
+// ahead as it gets, while the consumer (SLAM, one scan at a time) takes them as they become
+// ready. On two cores SLAM then runs beside the extraction instead of after it.
 
 #include <condition_variable>
 #include <cstddef>
@@ -29,10 +29,9 @@ class KeypointStream {
   KeypointStream& operator=(const KeypointStream&) = delete;
 
   /// The keypoints of log.scans[order[k]], waiting until they are extracted; rethrows what the
-  /// extraction threw, for this scan or an earlier one of the order.
+  /// extraction threw for a scan of k's batch (32 scans) or an earlier one. Throws
+  /// std::out_of_range for k >= order.size().
   const std::vector<Keypoint>& Wait(std::size_t k);
-  /// Every scan's keypoints by scan index (all extracted first); the stream is left empty.
-  std::vector<std::vector<Keypoint>> TakeAll();
   /// Wall time from the start to the last scan extracted (0 before that).
   double seconds() const;
 

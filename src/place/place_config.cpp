@@ -64,7 +64,8 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
                {C::DescriptorIndex::kKdTree, "kdtree"},
                {C::DescriptorIndex::kDense, "dense"}},
               "how descriptor pairs are found (same pairs): exhaustive chi2 (none), or a "
-              "square-root bound searched by a kd-tree (kdtree) or a matrix product (dense)")
+              "square-root bound searched by a kd-tree (kdtree) or a matrix product (dense); "
+              "with retrieval words, kdtree and dense both index the retrieved places densely")
         .Enum("retrieval", &C::retrieval,
               {{C::Retrieval::kAuto, "auto"},
                {C::Retrieval::kExact, "exact"},

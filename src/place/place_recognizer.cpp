@@ -310,7 +310,13 @@ void PlaceRecognizer::AddPlace(Place place) {
                                 ": positions and descriptors differ in size");
   }
   places_.push_back(std::move(place));
-  AddWordsOfLastPlace();
+  try {
+    AddWordsOfLastPlace();
+  } catch (...) {  // out of memory: the place is not added, the words describe places_ again
+    places_.pop_back();
+    RebuildWords();
+    throw;
+  }
   if (!index_) return;  // descriptor_index none, or retrieval words
   if (index_.use_count() > 1) {
     RebuildIndex();  // a copy shares the index: never change it under the copy

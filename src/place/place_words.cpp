@@ -144,11 +144,7 @@ PlaceWords::PlaceWords(const std::vector<Place>& places) {
   }
   postings_.assign(first_word_.empty() ? 0 : static_cast<std::size_t>(first_word_.back()), {});
   // By place, then by word within a place: each list in increasing place order.
-  for (std::size_t p = 0; p < places.size(); ++p) {
-    for (const auto& [word, count] : CountsOf(p)) {
-      postings_[static_cast<std::size_t>(word)].emplace_back(static_cast<int>(p), count);
-    }
-  }
+  for (std::size_t p = 0; p < places.size(); ++p) AddPostingsOf(p);
   Weigh();
 }
 
@@ -162,8 +158,9 @@ void PlaceWords::Append(const Place& place) {
     const int earlier = static_cast<int>(p);
     for (const int word : own_words_[n]) {
       std::vector<std::pair<int, int>>& list = postings_[static_cast<std::size_t>(word)];
-      // An entry is appended only with a place at most kNeighbours before it: every entry after
-      // place p's is of a place p - kNeighbours or later, so the search stops at an earlier one.
+      // An entry of place q is appended only while place q, q + 1, ... or q + kNeighbours is
+      // (or at construction, in place order): every entry after place p's is of a place
+      // p - kNeighbours or later, so the search stops at an earlier one.
       auto it = list.rbegin();
       while (it != list.rend() && it->first != earlier && it->first + kNeighbours >= earlier) ++it;
       if (it != list.rend() && it->first == earlier) {
@@ -174,10 +171,14 @@ void PlaceWords::Append(const Place& place) {
     }
   }
   // ... and it has its own neighbourhood's.
-  for (const auto& [word, count] : CountsOf(n)) {
-    postings_[static_cast<std::size_t>(word)].emplace_back(static_cast<int>(n), count);
-  }
+  AddPostingsOf(n);
   Weigh();
+}
+
+void PlaceWords::AddPostingsOf(std::size_t p) {
+  for (const auto& [word, count] : CountsOf(p)) {
+    postings_[static_cast<std::size_t>(word)].emplace_back(static_cast<int>(p), count);
+  }
 }
 
 bool PlaceWords::Neighbours(std::size_t p, std::size_t q) const {

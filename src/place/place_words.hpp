@@ -47,6 +47,8 @@ class PlaceWords {
   bool Neighbours(std::size_t p, std::size_t q) const;
   // The word counts of place p's neighbourhood (its own words and its neighbours'), by word.
   std::vector<std::pair<int, int>> CountsOf(std::size_t p) const;
+  // Appends place p's neighbourhood counts (CountsOf) to the postings.
+  void AddPostingsOf(std::size_t p);
   // idf_ and inverse_norms_ from postings_.
   void Weigh();
 

@@ -35,6 +35,10 @@ void Validate(const SlamConfig& config) {
   if (!(config.loop_sigma_rad > 0.0)) fail("loop_sigma_rad", "must be > 0");
   if (config.loop_reference_consensus < 1) fail("loop_reference_consensus", "must be >= 1");
   if (config.optimize_every_loops < 1) fail("optimize_every_loops", "must be >= 1");
+  if (!(config.defer_loop_residual_sigmas >= 0.0 &&
+        std::isfinite(config.defer_loop_residual_sigmas))) {
+    fail("defer_loop_residual_sigmas", "must be >= 0 and finite");
+  }
 }
 
 OnlineSlam::OnlineSlam(const SlamConfig& config, const FlirtConfig& features)
@@ -313,7 +317,7 @@ void OnlineSlam::AddLoop(int id, double origin_path, LoopClosure loop) {
     dirty_ = true;
     // A loop the estimate already meets within its own sigmas would move it by less than its
     // noise: it waits (in the graph) for the next loop that disagrees, or for Finish().
-    if (graph_.WhitenedResidual(loop.edge) > 1.0) {
+    if (graph_.WhitenedResidual(loop.edge) > config_.defer_loop_residual_sigmas) {
       ++loops_since_optimization_;
     } else {
       ++stats_.loops_deferred;

@@ -79,7 +79,10 @@ const ConfigFields<SlamConfig>& SlamConfigFields() {
         .Int("loop_reference_consensus", &C::loop_reference_consensus, "",
              "loop sigmas scale with sqrt(this / consensus)")
         .Int("optimize_every_loops", &C::optimize_every_loops, "",
-             "optimise the graph after every N accepted loops")
+             "optimise the graph after every N accepted loops the estimate does not already meet")
+        .Double("defer_loop_residual_sigmas", &C::defer_loop_residual_sigmas, "sigma",
+                "a loop whose whitened residual at the current estimate is at most this waits "
+                "for the next optimisation (0: every loop is optimised at once)")
         .Nested("graph", &C::graph, PoseGraphConfigFields())
         .Nested("loop_refinement", &C::loop_refinement, LoopRefinementConfigFields());
     return table;

@@ -185,7 +185,7 @@ GlobalMap SlamNode::Map() const {
 }
 
 SavedSlamMap SlamNode::SaveMap(const std::string& map_path) {
-  slam_.Finish();  // loops not optimised yet (slam.optimize_every_loops > 1)
+  slam_.Finish();  // loops not optimised yet (deferred, or slam.optimize_every_loops > 1)
   const GlobalMap map = Map();
   if (map.submaps.empty()) {
     throw std::invalid_argument("no submap completed yet (" +

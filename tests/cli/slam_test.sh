@@ -76,7 +76,7 @@ assert g['occupied_matched'] > 0.85 and g['reference_matched'] > 0.85, g
 assert g['occupied_on_free'] < 0.05, g
 " "$work"
 # With --truth the grid is checked without --grid too (issue 34: the global-consistency check
-# beside the relation errors), with the same figures, and no grid file is written.
+# beside the relation errors), with the same figures.
 check "grid check without --grid" "$keyplace" slam "$raw" \
   --truth "$shared/data/fr079-corrected.log.gz" --index "$work/index.tsv" \
   --json "$work/slam-check.json"
@@ -88,6 +88,17 @@ a = json.load(open(sys.argv[1]))['grid_agreement']
 b = json.load(open(sys.argv[2]))['grid_agreement']
 assert a == b, (a, b)
 " "$work/slam.json" "$work/slam-check.json"
+# A grid too large for grid.max_cells only skips the check when --grid was not asked for.
+check "grid check skipped" "$keyplace" slam "$raw" \
+  --truth "$shared/data/fr079-corrected.log.gz" --index "$work/index.tsv" \
+  --set grid.max_cells=10000 --json "$work/slam-nocheck.json"
+cp "$work/out" "$work/nocheck.out"
+check "grid check skip said" grep -q "^grid agreement     not computed: .*grid.max_cells" \
+  "$work/nocheck.out"
+check "no grid check in the JSON" python3 -c "
+import json,sys
+assert 'grid_agreement' not in json.load(open(sys.argv[1]))
+" "$work/slam-nocheck.json"
 fails_with "--grid equal to --out" "--grid" "$keyplace" slam "$raw" --out "$work/same.yaml" \
   --grid "$work/same.yaml"
 fails_with "grid config checked" "grid.free_thresh" "$keyplace" slam "$raw" \

@@ -48,11 +48,7 @@ TEST(KeypointStream, GivesTheKeypointsOfEachScanInTheConsumersOrder) {
   }
   EXPECT_GT(with_keypoints, 90u);
   EXPECT_GT(stream.seconds(), 0.0);
-  const std::vector<std::vector<Keypoint>> all = stream.TakeAll();
-  ASSERT_EQ(all.size(), log.scans.size());
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    ExpectSameKeypoints(all[i], at_once[i], "scan " + std::to_string(i));
-  }
+  EXPECT_THROW(stream.Wait(order.size()), std::out_of_range);
 }
 
 TEST(KeypointStream, AnExtractionErrorReachesTheConsumer) {
@@ -62,7 +58,13 @@ TEST(KeypointStream, AnExtractionErrorReachesTheConsumer) {
   std::iota(order.begin(), order.end(), std::size_t{0});
   KeypointStream stream(log, order, FlirtConfig{});
   EXPECT_NO_THROW(stream.Wait(0));
-  EXPECT_THROW(stream.Wait(70), std::invalid_argument);
+  try {
+    stream.Wait(70);
+    ADD_FAILURE() << "the scan whose keypoints cannot be extracted gave keypoints";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("LaserScan.angles_rad has"), std::string::npos)
+        << error.what();
+  }
   EXPECT_THROW(stream.Wait(99), std::invalid_argument);
 }
 

@@ -23,6 +23,12 @@ namespace {
 
 using Retrieval = PlaceRecognitionConfig::Retrieval;
 
+PlaceRecognitionConfig ExactConfig() {
+  PlaceRecognitionConfig config;
+  config.retrieval = Retrieval::kExact;
+  return config;
+}
+
 PlaceRecognitionConfig WordsConfig(int places) {
   PlaceRecognitionConfig config;
   config.retrieval = Retrieval::kWords;
@@ -91,49 +97,81 @@ TEST(PlaceWords, AppendedPlacesJoinTheirNeighboursHistogramsAndTheIdf) {
   EXPECT_GT(ExpectNeighbourhoodsRetrieveTheirPlace(words, places, half - 2), 30);
 }
 
+struct AnswerCounts {
+  int correct = 0;
+  int wrong = 0;  // found but not correct
+};
+
+AnswerCounts CountAnswers(const std::vector<LocalizationRecord>& records) {
+  AnswerCounts counts;
+  for (const LocalizationRecord& record : records) {
+    counts.correct += record.correct ? 1 : 0;
+    counts.wrong += record.match.found && !record.correct ? 1 : 0;
+  }
+  return counts;
+}
+
+// Field for field, query by query.
+void ExpectSameAnswers(const std::vector<LocalizationRecord>& a,
+                       const std::vector<LocalizationRecord>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    testing::ExpectSameMatch(a[i].match, b[i].match, "query " + std::to_string(i));
+  }
+}
+
 TEST(Retrieval, WordsKeepTheRightAnswersOfTheBundledLogAndPairFewPlaces) {
   const testing::BundledMap& b = testing::BundledFr079();
   const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(5);
   const std::vector<Place> places = PlacesFromMap(b.map);
   constexpr int kRetrieved = 50;  // the default
   ASSERT_GT(places.size(), 4u * kRetrieved);
-  const std::vector<LocalizationRecord> exact = EvaluateQueries(
-      queries, PlaceRecognizer(places, PlaceRecognitionConfig{}), SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> exact =
+      EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
   const std::vector<LocalizationRecord> words = EvaluateQueries(
       queries, PlaceRecognizer(places, WordsConfig(kRetrieved)), SelfMatchRule::kSameScans);
   ASSERT_EQ(words.size(), exact.size());
-  int exact_correct = 0;
-  int exact_wrong = 0;
-  int words_correct = 0;
-  int words_wrong = 0;
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    exact_correct += exact[i].correct ? 1 : 0;
-    exact_wrong += exact[i].match.found && !exact[i].correct ? 1 : 0;
-    words_correct += words[i].correct ? 1 : 0;
-    words_wrong += words[i].match.found && !words[i].correct ? 1 : 0;
-    EXPECT_LE(words[i].match.candidates, kRetrieved);
-  }
-  ASSERT_GT(exact_correct, static_cast<int>(queries.size()) * 9 / 10);
+  for (const LocalizationRecord& record : words) EXPECT_LE(record.match.candidates, kRetrieved);
+  const AnswerCounts exact_counts = CountAnswers(exact);
+  const AnswerCounts words_counts = CountAnswers(words);
+  ASSERT_GT(exact_counts.correct, static_cast<int>(queries.size()) * 9 / 10);
   // A fifth of the places paired at most. The price, measured (docs/PLACE.md, "Retrieval"): 98
   // right answers of 100 become 96, and one look-alike is accepted where the right place, not
   // retrieved, cannot make it ambiguous. Places drawn at random would keep about a fifth.
-  EXPECT_GE(words_correct, exact_correct - 3);
-  EXPECT_LE(words_wrong, exact_wrong + 1);
+  EXPECT_GE(words_counts.correct, exact_counts.correct - 3);
+  EXPECT_LE(words_counts.wrong, exact_counts.wrong + 1);
+}
+
+// The places retrieved get an index of their own per query: whatever descriptor_index says, the
+// pairs are those of exhaustive matching, so the answers are the same field for field (places
+// retrieved far apart in the map, so a wrong slot of a place would pair another place's keypoints).
+TEST(Retrieval, EveryDescriptorIndexGivesTheSameAnswersOfTheRetrievedPlaces) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(20);
+  PlaceRecognitionConfig config = WordsConfig(10);
+  config.descriptor_index = PlaceRecognitionConfig::DescriptorIndex::kNone;
+  const std::vector<LocalizationRecord> oracle =
+      EvaluateQueries(queries, PlaceRecognizer(places, config), SelfMatchRule::kSameScans);
+  ASSERT_GT(CountAnswers(oracle).correct, static_cast<int>(queries.size()) / 2);
+  for (const auto index : {PlaceRecognitionConfig::DescriptorIndex::kKdTree,
+                           PlaceRecognitionConfig::DescriptorIndex::kDense}) {
+    config.descriptor_index = index;
+    ExpectSameAnswers(
+        EvaluateQueries(queries, PlaceRecognizer(places, config), SelfMatchRule::kSameScans),
+        oracle);
+  }
 }
 
 // Retrieving every place is the exact path: the same answers, field for field.
 TEST(Retrieval, RetrievingEveryPlaceIsTheExactPath) {
   const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
   const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
-  const std::vector<LocalizationRecord> exact = EvaluateQueries(
-      queries, PlaceRecognizer(places, PlaceRecognitionConfig{}), SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> exact =
+      EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
   const std::vector<LocalizationRecord> words = EvaluateQueries(
       queries, PlaceRecognizer(places, WordsConfig(static_cast<int>(places.size()))),
       SelfMatchRule::kSameScans);
-  ASSERT_EQ(words.size(), exact.size());
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    testing::ExpectSameMatch(words[i].match, exact[i].match, "query " + std::to_string(i));
-  }
+  ExpectSameAnswers(words, exact);
 }
 
 // A removal learns the vocabulary anew: places added one by one and then one removed retrieve as
@@ -149,14 +187,37 @@ TEST(Retrieval, ChangedPlaceByPlaceItRetrievesAsOneBuiltAtOnce) {
   expected_places.erase(expected_places.begin() + 3);
   const PlaceRecognizer at_once(expected_places, config);
   const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
-  const std::vector<LocalizationRecord> a =
-      EvaluateQueries(queries, grown, SelfMatchRule::kSameScans);
-  const std::vector<LocalizationRecord> b =
-      EvaluateQueries(queries, at_once, SelfMatchRule::kSameScans);
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    testing::ExpectSameMatch(a[i].match, b[i].match, "query " + std::to_string(i));
-  }
+  ExpectSameAnswers(EvaluateQueries(queries, grown, SelfMatchRule::kSameScans),
+                    EvaluateQueries(queries, at_once, SelfMatchRule::kSameScans));
+}
+
+// The vocabulary is learned anew when the places hold twice the keypoints it was learned from:
+// right after the place that doubles them, the grown recognizer answers as one built at once.
+// A copy made before the additions keeps answering as before them (the words are not shared).
+TEST(Retrieval, AtTwiceTheKeypointsItAnswersAsOneBuiltAtOnceAndCopiesStayApart) {
+  const std::vector<Place> all = PlacesFromMap(testing::BundledFr079().map);
+  const PlaceRecognitionConfig config = WordsConfig(20);
+  const std::size_t first = all.size() / 4;
+  std::size_t keypoints = 0;
+  for (std::size_t p = 0; p < first; ++p) keypoints += all[p].descriptors.size();
+  const std::size_t learned = keypoints;
+  std::size_t doubled = first;  // the place whose addition doubles the keypoints
+  while (keypoints < 2 * learned) keypoints += all[doubled++].descriptors.size();
+  ASSERT_LT(doubled, all.size());
+  PlaceRecognizer grown(std::vector<Place>(all.begin(), all.begin() + first), config);
+  const PlaceRecognizer copy = grown;
+  for (std::size_t p = first; p < doubled; ++p) grown.AddPlace(all[p]);
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
+  ExpectSameAnswers(
+      EvaluateQueries(queries, grown, SelfMatchRule::kSameScans),
+      EvaluateQueries(
+          queries, PlaceRecognizer(std::vector<Place>(all.begin(), all.begin() + doubled), config),
+          SelfMatchRule::kSameScans));
+  ExpectSameAnswers(
+      EvaluateQueries(queries, copy, SelfMatchRule::kSameScans),
+      EvaluateQueries(queries,
+                      PlaceRecognizer(std::vector<Place>(all.begin(), all.begin() + first), config),
+                      SelfMatchRule::kSameScans));
 }
 
 // A recognizer grown place by place from one place (as SLAM grows its map) learns its vocabulary
@@ -173,19 +234,11 @@ TEST(Retrieval, GrownFromOnePlaceItAnswersAsWellAsOneBuiltAtOnce) {
   const std::vector<LocalizationRecord> b =
       EvaluateQueries(queries, PlaceRecognizer(places, config), SelfMatchRule::kSameScans);
   ASSERT_EQ(a.size(), b.size());
-  int grown_correct = 0;
-  int at_once_correct = 0;
-  int grown_wrong = 0;
-  int at_once_wrong = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    grown_correct += a[i].correct ? 1 : 0;
-    at_once_correct += b[i].correct ? 1 : 0;
-    grown_wrong += a[i].match.found && !a[i].correct ? 1 : 0;
-    at_once_wrong += b[i].match.found && !b[i].correct ? 1 : 0;
-  }
-  ASSERT_GT(at_once_correct, static_cast<int>(queries.size()) * 8 / 10);
-  EXPECT_GE(grown_correct, at_once_correct - 3);
-  EXPECT_LE(grown_wrong, at_once_wrong + 1);
+  const AnswerCounts grown_counts = CountAnswers(a);
+  const AnswerCounts at_once_counts = CountAnswers(b);
+  ASSERT_GT(at_once_counts.correct, static_cast<int>(queries.size()) * 8 / 10);
+  EXPECT_GE(grown_counts.correct, at_once_counts.correct - 3);
+  EXPECT_LE(grown_counts.wrong, at_once_counts.wrong + 1);
 }
 
 TEST(Retrieval, PlacesMustBePositive) {

@@ -269,6 +269,9 @@ TEST(OnlineSlam, RejectsInvalidConfig) {
   config = SlamConfig();
   config.loop_sigma_m = 0.0;
   EXPECT_THROW(Validate(config), std::invalid_argument);
+  config = SlamConfig();
+  config.defer_loop_residual_sigmas = -1.0;
+  EXPECT_THROW(Validate(config), std::invalid_argument);
 }
 
 }  // namespace

@@ -238,7 +238,8 @@ class PlaceRecognizer {
   const PlaceRecognitionConfig& config() const { return config_; }
 
  private:
-  // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for kNone.
+  // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for
+  // descriptor_index none or retrieval words (the retrieved places get one per query).
   void RebuildIndex();
   // The vocabulary and word histograms of places_ (retrieval kWords), learned anew.
   void RebuildWords();
@@ -247,10 +248,10 @@ class PlaceRecognizer {
 
   std::vector<Place> places_;
   PlaceRecognitionConfig config_;
-  std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none
+  std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none or words
   std::vector<std::size_t> slots_;              // index place number of each of places_
   std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
-  std::shared_ptr<PlaceWords> words_;           // null for retrieval exact
+  std::shared_ptr<PlaceWords> words_;           // null unless retrieval words
 };
 
 }  // namespace keyplace
