@@ -171,7 +171,8 @@ void RegisterSlamCommand(CLI::App& app) {
       "Online SLAM on a raw log (paper Section 6.2.2): ICP odometry, submaps of stable keypoints, "
       "loop closure by place recognition, pose graph over submap origins (Ceres). Prints loop "
       "counts, loop precision by submap overlap, Table IX and, with --truth/--relations, "
-      "ATE/RPE and relation errors. Tuning: --set slam.KEY=VALUE (e.g. "
+      "ATE/RPE, the SLAM grid against the corrected-pose grid and relation errors. Tuning: --set "
+      "slam.KEY=VALUE (e.g. "
       "slam.exclude_recent_submaps, slam.gate_base_m=0 for no gate, slam.loop_refinement.refine), "
       "--set mapping.KEY=VALUE, --set place.KEY=VALUE, --preset paper.");
   command
