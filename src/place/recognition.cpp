@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -120,6 +121,21 @@ void KeepRetrieved(const PlaceWords& words, const std::vector<BetaGridDescriptor
     searched[static_cast<std::size_t>(order[k])] = 0;
 }
 
+// Retrieval pairs a few places: they get a dense index of their own for the query (the same pairs
+// as any index), so that the recognizer keeps none over the whole map. `slot_of[p]`: the index
+// slot of each searched place p.
+std::unique_ptr<SqrtDescriptorIndex> IndexOfRetrieved(const std::vector<Place>& places,
+                                                      const std::vector<char>& searched,
+                                                      std::vector<std::size_t>& slot_of) {
+  auto index = std::make_unique<SqrtDescriptorIndex>(
+      std::vector<Place>{}, PlaceRecognitionConfig::DescriptorIndex::kDense);
+  slot_of.assign(places.size(), 0);
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    if (searched[p]) slot_of[p] = index->AddPlace(places[p].descriptors);
+  }
+  return index;
+}
+
 Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorIndex* index,
                        const std::vector<std::size_t>& slots, const PlaceRecognitionConfig& config,
                        const std::vector<BetaGridDescriptor>& query, std::size_t min_pairs,
@@ -146,18 +162,13 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
   // The index finds, per place, the pairs below the threshold that the exhaustive loop of
   // MatchDescriptorPairs finds, in its order and with its distances.
   std::vector<std::vector<DescriptorPair>> below;  // by index slot
-  std::vector<std::size_t> slot_of = slots;        // index slot of each place
-  // Retrieval pairs a few places: they get a dense index of their own for this query (the same
-  // pairs as any index), so that the recognizer keeps none over the whole map.
-  std::optional<SqrtDescriptorIndex> retrieved;
+  std::vector<std::size_t> retrieved_slots;
+  std::unique_ptr<SqrtDescriptorIndex> retrieved;
   if (words && config.descriptor_index != PlaceRecognitionConfig::DescriptorIndex::kNone) {
-    retrieved.emplace(std::vector<Place>{}, PlaceRecognitionConfig::DescriptorIndex::kDense);
-    slot_of.assign(places.size(), 0);
-    for (std::size_t p = 0; p < places.size(); ++p) {
-      if (searched[p]) slot_of[p] = retrieved->AddPlace(places[p].descriptors);
-    }
-    index = &*retrieved;
+    retrieved = IndexOfRetrieved(places, searched, retrieved_slots);
+    index = retrieved.get();
   }
+  const std::vector<std::size_t>& slot_of = retrieved ? retrieved_slots : slots;
   if (index) {
     std::vector<char> searched_slots(index->places(), 0);
     for (std::size_t p = 0; p < places.size(); ++p) {
