@@ -48,8 +48,11 @@ void PrintOdometryRun(const OdometryRun& run) {
       "recovered       {} (the prediction was wrong: ICP converged from a searched pose, or the "
       "odometry glitched)\n",
       s.recovered);
-  fmt::print("fallbacks       {} not converged, {} correction too large, {} too few points\n",
-             s.not_converged, s.fallback_correction_too_large, s.fallback_too_few_points);
+  fmt::print(
+      "fallbacks       {} not converged, {} correction too large, {} too few points, {} weak "
+      "matches the odometry contradicts\n",
+      s.not_converged, s.fallback_correction_too_large, s.fallback_too_few_points,
+      s.fallback_weak_match);
   fmt::print("degenerate      {}\n", s.degenerate);
   fmt::print("key scans       {}\n", s.keyframes);
   fmt::print("time per scan   {:.3f} ms mean, {:.3f} ms max ({:.1f} s in total)\n",
@@ -88,6 +91,7 @@ nlohmann::json OdometryRunJson(const OdometryRun& run) {
           {"not_converged", s.not_converged},
           {"fallback_correction_too_large", s.fallback_correction_too_large},
           {"fallback_too_few_points", s.fallback_too_few_points},
+          {"fallback_weak_match", s.fallback_weak_match},
           {"degenerate", s.degenerate},
           {"keyframes", s.keyframes},
           {"missing_odometry", s.missing_odometry},

@@ -73,6 +73,9 @@ OdometryRunStats SummarizeOdometryRun(const std::vector<ScanOdometryResult>& res
       case ScanOdometryStatus::kFallbackTooFewPoints:
         ++stats.fallback_too_few_points;
         break;
+      case ScanOdometryStatus::kFallbackWeakMatch:
+        ++stats.fallback_weak_match;
+        break;
       case ScanOdometryStatus::kFirstScan:
         break;
     }

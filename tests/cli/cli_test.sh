@@ -66,7 +66,7 @@ assert sum(r[2] == 'registered' for r in rows) == j['registered'], j['registered
 assert sum(r[2] == 'fallback_not_converged' for r in rows) == j['not_converged']
 assert all(r[10:] == ['nan'] * 5 for r in rows), rows[0]
 assert j['registered'] + j['recovered'] + j['not_converged'] + j['fallback_correction_too_large'] \
-    + j['fallback_too_few_points'] == 99, j
+    + j['fallback_too_few_points'] + j['fallback_weak_match'] == 99, j
 c=j['config']
 assert c['odometry']['icp']['kernel'] == 'huber', c['odometry']
 assert float(c['evaluation']['local_relation_max_dt_s']) == 2, c['evaluation']" "$work/odo.json" \

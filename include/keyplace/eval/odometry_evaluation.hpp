@@ -48,6 +48,7 @@ struct OdometryRunStats {
   std::size_t not_converged = 0;  // kFallbackNotConverged
   std::size_t fallback_correction_too_large = 0;  // kFallbackCorrectionTooLarge
   std::size_t fallback_too_few_points = 0;        // kFallbackTooFewPoints
+  std::size_t fallback_weak_match = 0;            // kFallbackWeakMatch
   std::size_t degenerate = 0;                     // ICP held a weak direction at the guess
   std::size_t keyframes = 0;                      // scans added to the local map
   std::size_t missing_odometry = 0;               // scans without an odometry pose

@@ -88,6 +88,10 @@ enum class ScanOdometryStatus {
   kFallbackNotConverged,        // ICP did not converge: pose = odometry prediction
   kFallbackCorrectionTooLarge,  // ICP converged too far from the prediction: odometry used
   kFallbackTooFewPoints,        // scan or map too small for ICP: odometry used
+  // ICP converged on far fewer of the scan's points than the recent scans' matches had (something
+  // near the laser hides the map: a person) to a step the odometry contradicts beyond its recent
+  // agreement with ICP: odometry used
+  kFallbackWeakMatch,
 };
 
 std::string ToString(ScanOdometryStatus status);
@@ -143,6 +147,15 @@ class ScanOdometry {
   std::optional<IcpResult> Recover(const std::vector<Eigen::Vector2d>& source_laser,
                                    const Pose2& predicted_T_world_laser) const;
   bool WithinCorrectionBounds(const Pose2& correction) const;
+  /// ICP's result from the odometry's prediction matched few points (below a fraction of the
+  /// recent matches' median inlier ratio) and parts from the prediction, per unit of the
+  /// odometry's motion `odometry_step`, by many times the recent median (`agreement_window_`, the
+  /// odometry's trust as measured online): a weak match that the trusted odometry contradicts.
+  bool WeakMatchContradictsOdometry(const IcpResult& icp, const Pose2& predicted_T_world_laser,
+                                    const Pose2& odometry_step) const;
+  /// Adds a registered step to `agreement_window_`.
+  void RecordAgreement(const ScanOdometryResult& result, const Pose2& predicted_T_world_laser,
+                       const Pose2& odometry_step);
   /// The odometry's total over `odometry_window_` (not empty) applied to its oldest pose.
   Pose2 OdometryTotal(const Pose2& odometry_laser) const;
   /// The odometry's total over `odometry_window_` applied to its oldest pose, when the window is
@@ -196,6 +209,13 @@ class ScanOdometry {
     Pose2 T_odom_laser;
   };
   std::deque<Past> odometry_window_;
+  // The latest registered scans with odometry: the match's inlier ratio and how far ICP's step
+  // parted from the odometry's per unit of motion (the odometry's trust, measured online).
+  struct Agreement {
+    double inlier_ratio = 0.0;
+    double disagreement_per_motion = 0.0;
+  };
+  std::deque<Agreement> agreement_window_;
   Pose2 last_keyframe_T_world_laser_;
   struct Keyframe {
     std::vector<Eigen::Vector2d> points_world;  // endpoints, world frame
