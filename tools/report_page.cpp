@@ -8,6 +8,7 @@
 
 #include "report_figures.hpp"
 #include "report_hospital.hpp"
+#include "report_map_size.hpp"
 #include "report_tables.hpp"
 
 namespace keyplace::cli {
@@ -85,6 +86,7 @@ std::string PageHeader(const ReportContext& context, double run_seconds) {
       "Figure 9, Tables VII–VIII</a> · <a href=\"#relocalize\">kidnapped robot</a> · "
       "<a href=\"#slam\">Table IX, loops, Figures 10–12</a> · "
       "<a href=\"#hospital\">hospital bag</a> · "
+      "<a href=\"#map-size\">map size</a> · "
       "<a href=\"#table10\">Table X</a> · <a href=\"#commands\">commands</a></p>\n";
   return html;
 }
@@ -129,6 +131,7 @@ std::string BuildPage(ReportContext& context, double run_seconds) {
   body += TableIX(context);
   body += SlamFigures(context);
   body += HospitalSection(context);
+  body += MapSizeSection(context);
   body += "<h2 id=\"comparison\">Comparison with TIP-FLIRT (Section 6.3)</h2>\n";
   body += TableX(context);
   body += WarningsSection(context);

@@ -17,6 +17,7 @@
 #include <fmt/core.h>
 
 #include "io/atomic_file.hpp"
+#include "report_map_size.hpp"
 
 extern char** environ;  // NOLINT(readability-redundant-declaration): POSIX, for posix_spawn
 
@@ -349,6 +350,8 @@ std::vector<ReportStep> PlanReport(const ReportSettings& s) {
                      {A::HospitalBag(s), A::HospitalRelations(s)},
                      {Join(slam, "slam.json"), Join(slam, "figures/trajectory.png")}});
   }
+  const std::vector<ReportStep> map_size = PlanMapSizeSteps(s);
+  steps.insert(steps.end(), map_size.begin(), map_size.end());
   return steps;
 }
 

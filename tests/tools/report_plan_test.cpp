@@ -1,6 +1,7 @@
 // Unit tests of the report's plan and of a table drawn from a hand-made artefact: the kidnapped
 // robot's steps (keyplace relocalize) and its table.
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 
 #include "report_context.hpp"
 #include "report_hospital.hpp"
+#include "report_map_size.hpp"
 #include "report_plan.hpp"
 #include "report_tables.hpp"
 
@@ -95,6 +97,7 @@ TEST(ReportPlanTest, LocalizeAndRelocalizeStepsUseTheReportsThreads) {
   int steps_with_queries = 0;
   for (const ReportStep& step : PlanReport(settings)) {
     if (step.args[0] != "localize" && step.args[0] != "relocalize") continue;
+    if (step.id.rfind("map-size-", 0) == 0) continue;  // one core by definition (below)
     ++steps_with_queries;
     const auto threads = std::find(step.args.begin(), step.args.end(), "--threads");
     ASSERT_NE(threads, step.args.end()) << step.id;
@@ -226,6 +229,71 @@ TEST(ReportHospitalTest, PlannedWhenTheBagExistsAndRenderedFromItsJson) {
   EXPECT_NE(html.find("0.143 ± 0.180 m"), std::string::npos);
   // The trajectory figure is missing: its note names the step.
   EXPECT_NE(html.find("not computed: run <code>keyplace slam "), std::string::npos) << html;
+}
+
+// Issue 35: FR079 among the other data sets' submaps, both retrievals, on one core; rendered as a
+// table with the exact / words ratio and a figure.
+TEST(ReportMapSizeTest, PlannedWithDistractorsAndRenderedFromItsJson) {
+  const fs::path dir = fs::temp_directory_path() / "keyplace_report_map_size_test";
+  fs::remove_all(dir);
+  ReportContext context;
+  context.settings.data_dir = (dir / "data").string();
+  context.settings.work_dir = (dir / "work").string();
+  context.settings.datasets = {"fr079"};
+  context.settings.quick = true;
+  EXPECT_TRUE(PlanMapSizeSteps(context.settings).empty());  // no other building to copy
+  EXPECT_NE(MapSizeSection(context).find("needs FR079 and at least one other data set"),
+            std::string::npos);
+  context.settings.datasets = {"fr079", "intel", "fr101"};
+  EXPECT_EQ(PlanMapSizeSteps(context.settings).size(), 2u);  // quick: 10^3 submaps
+  context.settings.quick = false;
+  context.steps = PlanReport(context.settings);
+  context.outcomes.resize(context.steps.size());
+  const ReportStep& step = context.steps[IndexOf(context.steps, "map-size-words-10000")];
+  const std::string command = CommandLine(step);
+  EXPECT_NE(command.find("--distractors " + ReportArtefacts::Map(context.settings, "intel") + "," +
+                         ReportArtefacts::Map(context.settings, "fr101") +
+                         " --distractor-submaps 10000 --n-pos 20 --threads 1 "),
+            std::string::npos)
+      << command;
+  EXPECT_NE(command.find("--set place.retrieval=words --json " +
+                         MapSizeJson(context.settings, "words", 10000)),
+            std::string::npos)
+      << command;
+  EXPECT_LT(IndexOf(context.steps, "map-intel"), IndexOf(context.steps, "map-size-exact-1000"));
+
+  auto write = [&](const std::string& retrieval, int submaps, double seconds, double recall) {
+    const std::string path = MapSizeJson(context.settings, retrieval, submaps);
+    fs::create_directories(fs::path(path).parent_path());
+    std::ofstream(path) << fmt::format(
+        R"({{"seconds_per_query_mean": {}, "precision": 1.0, "recall": {},
+        "seconds_preparation": 2.5}})",
+        seconds, recall);
+  };
+  write("exact", 1000, 0.096, 0.95);
+  write("words", 1000, 0.012, 0.90);
+  context.figures_dir = (dir / "figures").string();
+  fs::create_directories(context.figures_dir);
+  const std::string html = MapSizeSection(context);
+  const bool figure = fs::exists(dir / "figures/map-size.png");
+  fs::remove_all(dir);
+  EXPECT_NE(html.find("<tr><td>1000</td><td>exact</td><td>96.0</td><td>–</td><td>1.000</td>"
+                      "<td>0.950</td><td>2.5</td></tr>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<tr><td>1000</td><td>words</td><td>12.0</td><td>8.0</td><td>1.000</td>"
+                      "<td>0.900</td><td>2.5</td></tr>"),
+            std::string::npos)
+      << html;
+  // 10^4 and 10^5 are not computed yet: their rows say how.
+  EXPECT_NE(
+      html.find(
+          "<tr><td>10000</td><td>exact</td><td colspan=\"5\" class=\"missing\">not computed: run "
+          "<code>keyplace localize --map "),
+      std::string::npos)
+      << html;
+  EXPECT_TRUE(figure);
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
 }
 
 }  // namespace
