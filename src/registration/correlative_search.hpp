@@ -32,8 +32,6 @@ class ProximityField {
   double At(const Eigen::Vector2d& point) const;
 
   double cell_m() const { return cell_m_; }
-  /// The corner of cell (0, 0).
-  const Eigen::Vector2d& origin() const { return origin_; }
   int width() const { return width_; }
   /// The cell column and row of a point (may lie outside [0, width)).
   Eigen::Vector2d CellCoordinates(const Eigen::Vector2d& point) const {

@@ -7,9 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include <cstdlib>
 #include "correlative_search.hpp"
-#include "grid_refinement.hpp"
 
 namespace keyplace {
 namespace {
@@ -433,29 +431,6 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       T_world_laser = Register(points, predicted_T_world_laser,
                                DisputingMotion(predicted_T_world_laser, increment_measured),
                                odometry_laser, result);
-    }
-    static const int grid_mode = std::getenv("KP_GRID") ? std::atoi(std::getenv("KP_GRID")) : 0;
-    const bool is_fallback = !IsIcpPose(result.status);
-    if (grid_mode > 0 && (grid_mode == 1 || is_fallback) &&
-        static_cast<int>(map_points_.size()) >= config_.icp.min_points && !points.empty()) {
-      const std::vector<Eigen::Vector2d> source =
-          SubsampleBySpacing(points, config_.source_min_spacing_m);
-      double reach_m = 0.0;
-      for (const Eigen::Vector2d& p : source) reach_m = std::max(reach_m, p.norm());
-      static const double sigma =
-          std::getenv("KP_SIGMA") ? std::atof(std::getenv("KP_SIGMA")) : 0.05;
-      const ProximityField field(map_points_, T_world_laser.translation(), reach_m + 0.5, 0.05,
-                                 sigma);
-      GridRefinementWeights weights;
-      static const double wt = std::getenv("KP_WT") ? std::atof(std::getenv("KP_WT")) : 10.0;
-      static const double wr = std::getenv("KP_WR") ? std::atof(std::getenv("KP_WR")) : 40.0;
-      weights.translation_per_m = wt;
-      weights.rotation_per_rad = wr;
-      const GridRefinement refined = RefineOnField(field, source, T_world_laser, weights);
-      if (refined.usable && refined.mean_field >= refined.start_field &&
-          WithinCorrectionBounds(Between(T_world_laser, refined.T_target_source))) {
-        T_world_laser = refined.T_target_source;
-      }
     }
     result.converged = IsIcpPose(result.status);
     result.fell_back = !result.converged;
