@@ -160,6 +160,9 @@ std::string MapSizeSection(ReportContext& context) {
     }
   }
   html += "</table>\n";
+  bool any_json = false;
+  for (const SizeRow& row : rows) any_json = any_json || row.json.has_value();
+  if (!any_json) return html + MissingHtml("figure: no map-size step has run yet");
   const std::string png = (fs::path(context.figures_dir) / "map-size.png").string();
   try {
     DrawMapSizeFigure(rows, png);

@@ -218,8 +218,7 @@ bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
          std::abs(correction.theta) <= config_.max_correction_rotation_rad;
 }
 
-bool ScanOdometry::WeakMatchContradictsOdometry(const IcpResult& icp,
-                                                const Pose2& predicted_T_world_laser,
+bool ScanOdometry::WeakMatchContradictsOdometry(double inlier_ratio, const Pose2& correction,
                                                 const Pose2& odometry_step) const {
   if (agreement_window_.size() < kAgreementMinScans) return false;
   std::vector<double> ratios;
@@ -228,19 +227,26 @@ bool ScanOdometry::WeakMatchContradictsOdometry(const IcpResult& icp,
     ratios.push_back(a.inlier_ratio);
     disagreements.push_back(a.disagreement_per_motion);
   }
-  if (icp.inlier_ratio >= kWeakMatchInlierFraction * Median(ratios)) return false;
-  const Pose2 correction = Between(predicted_T_world_laser, icp.T_target_source);
+  if (inlier_ratio >= kWeakMatchInlierFraction * Median(ratios)) return false;
   return DisagreementPerMotion(correction, odometry_step) >
          kContradictionMedians * Median(disagreements);
 }
 
-void ScanOdometry::RecordAgreement(const ScanOdometryResult& result,
-                                   const Pose2& predicted_T_world_laser,
+void ScanOdometry::RecordAgreement(double inlier_ratio, const Pose2& correction,
                                    const Pose2& odometry_step) {
-  const Pose2 correction = Between(predicted_T_world_laser, result.T_world_laser);
-  agreement_window_.push_back(
-      {result.inlier_ratio, DisagreementPerMotion(correction, odometry_step)});
+  agreement_window_.push_back({inlier_ratio, DisagreementPerMotion(correction, odometry_step)});
   while (agreement_window_.size() > kAgreementWindowScans) agreement_window_.pop_front();
+}
+
+// A scan joins the local map when it moved or turned far enough from the last key scan, or
+// while the map is too small for ICP; never one whose view the map just found mostly foreign
+// (a weak match: it would bring the occluder into the map).
+bool ScanOdometry::WantsKeyframe(const Pose2& T_world_laser, ScanOdometryStatus status) const {
+  const bool map_too_small = static_cast<int>(map_points_.size()) < config_.icp.min_points;
+  if (status == ScanOdometryStatus::kFallbackWeakMatch && !map_too_small) return false;
+  const Pose2 since_keyframe = Between(last_keyframe_T_world_laser_, T_world_laser);
+  return TranslationNorm(since_keyframe) >= config_.keyframe_translation_m ||
+         std::abs(since_keyframe.theta) >= config_.keyframe_rotation_rad || map_too_small;
 }
 
 // Two independent predictions of this scan's pose: the odometry's, and the previous step as ICP
@@ -285,7 +291,7 @@ std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
 // ICP from the prediction, the checks of its result and the recovery: the scan's pose, and its
 // status and ICP figures in `result` (the prediction itself when the scan falls back).
 Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
-                             const Pose2& predicted_T_world_laser,
+                             const Pose2& predicted_T_world_laser, const Pose2& odometry_step,
                              const std::optional<Pose2>& disputing_motion,
                              const Pose2& odometry_laser, ScanOdometryResult& result) const {
   Pose2 T_world_laser = predicted_T_world_laser;
@@ -293,19 +299,17 @@ Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
       SubsampleBySpacing(points, config_.source_min_spacing_m);
   const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
   RecordIcp(icp, &result);
+  const Pose2 correction = Between(predicted_T_world_laser, icp.T_target_source);
   if (!icp.converged) {
     result.status = icp.status == IcpStatus::kTooFewPoints
                         ? ScanOdometryStatus::kFallbackTooFewPoints
                         : ScanOdometryStatus::kFallbackNotConverged;
-  } else if (!disputing_motion &&
-             WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source)) &&
-             WeakMatchContradictsOdometry(
-                 icp, predicted_T_world_laser,
-                 Between(previous_T_world_laser_, predicted_T_world_laser))) {
-    // The odometry is not disputed by the previous motion either: trust it over a match that
-    // most of the scan does not support.
+  } else if (!disputing_motion && WithinCorrectionBounds(correction) &&
+             WeakMatchContradictsOdometry(icp.inlier_ratio, correction, odometry_step)) {
+    // The odometry is not disputed by the previous motion either: trust it over a match on far
+    // fewer points than the recent ones had.
     result.status = ScanOdometryStatus::kFallbackWeakMatch;
-  } else if (WithinCorrectionBounds(Between(predicted_T_world_laser, icp.T_target_source))) {
+  } else if (WithinCorrectionBounds(correction)) {
     result.status = ScanOdometryStatus::kRegistered;
     T_world_laser = icp.T_target_source;
     const std::optional<IcpResult> better =
@@ -428,7 +432,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
       result.status = ScanOdometryStatus::kFallbackTooFewPoints;
       result.icp_status = IcpStatus::kTooFewPoints;
     } else {
-      T_world_laser = Register(points, predicted_T_world_laser,
+      T_world_laser = Register(points, predicted_T_world_laser, odometry_increment,
                                DisputingMotion(predicted_T_world_laser, increment_measured),
                                odometry_laser, result);
     }
@@ -436,14 +440,11 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     result.fell_back = !result.converged;
     result.T_world_laser = T_world_laser;
     if (result.status == ScanOdometryStatus::kRegistered && increment_measured) {
-      RecordAgreement(result, predicted_T_world_laser, odometry_increment);
+      RecordAgreement(result.inlier_ratio, Between(predicted_T_world_laser, T_world_laser),
+                      odometry_increment);
     }
     result.T_world_robot = T_world_laser * T_robot_laser.inverse();
-
-    const Pose2 since_keyframe = Between(last_keyframe_T_world_laser_, T_world_laser);
-    if (!points.empty() && (TranslationNorm(since_keyframe) >= config_.keyframe_translation_m ||
-                            std::abs(since_keyframe.theta) >= config_.keyframe_rotation_rad ||
-                            static_cast<int>(map_points_.size()) < config_.icp.min_points)) {
+    if (!points.empty() && WantsKeyframe(T_world_laser, result.status)) {
       result.keyframe = true;
       AddKeyframe(points, T_world_laser);
     }

@@ -107,18 +107,20 @@ TEST(OdometryEvaluationTest, SummaryCountsEachStatusAndAveragesIterationsOverReg
       result(S::kFallbackTooFewPoints, 0, 0.001, false, false),
       result(S::kFallbackNotConverged, 30, 0.005, false, false),
       result(S::kRegistered, 6, 0.003, true, true),
-      result(S::kRecovered, 9, 0.002, false, false)};
+      result(S::kRecovered, 9, 0.002, false, false),
+      result(S::kFallbackWeakMatch, 14, 0.003, false, false)};
   const OdometryRunStats s = SummarizeOdometryRun(results);
-  EXPECT_EQ(s.scans, 9u);
+  EXPECT_EQ(s.scans, 10u);
   EXPECT_EQ(s.registered, 3u);
   EXPECT_EQ(s.recovered, 1u);
   EXPECT_EQ(s.not_converged, 2u);
   EXPECT_EQ(s.fallback_correction_too_large, 1u);
   EXPECT_EQ(s.fallback_too_few_points, 1u);
+  EXPECT_EQ(s.fallback_weak_match, 1u);
   EXPECT_EQ(s.keyframes, 3u);
   EXPECT_EQ(s.degenerate, 3u);
   EXPECT_DOUBLE_EQ(s.iterations_mean, 6.0);  // (4 + 8 + 6) / 3: only the registered scans'
-  EXPECT_DOUBLE_EQ(s.seconds_per_scan_mean, 0.026 / 9);
+  EXPECT_DOUBLE_EQ(s.seconds_per_scan_mean, 0.029 / 10);
   EXPECT_DOUBLE_EQ(s.seconds_per_scan_max, 0.006);
 
   const OdometryRunStats empty = SummarizeOdometryRun({});

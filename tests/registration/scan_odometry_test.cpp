@@ -613,10 +613,18 @@ TEST(ScanOdometryTest, WeakMatchTheOdometryContradictsFallsBackToTheOdometry) {
   EXPECT_LT(occluded.result.inlier_ratio, 0.5);
   EXPECT_LT(occluded.heading_error_deg, 0.5);
   EXPECT_LT(occluded.worst_heading_error_deg, 0.5);
+  EXPECT_FALSE(occluded.result.keyframe);  // the person stays out of the local map
   // A few hidden beams leave a match most of the scan supports: ICP's pose is kept.
   const OccludedScan glimpse = DriveWithAnOccludedScan(20, 0);
   EXPECT_EQ(glimpse.result.status, ScanOdometryStatus::kRegistered);
   EXPECT_LT(glimpse.heading_error_deg, 0.5);
+  // A person alone hides as much, but ICP still finds the pose the odometry predicts: a weak match
+  // the odometry agrees with is kept.
+  const OccludedScan person = DriveWithAnOccludedScan(0, 135);
+  const OccludedScan clear = DriveWithAnOccludedScan(0, 0);
+  EXPECT_EQ(person.result.status, ScanOdometryStatus::kRegistered);
+  EXPECT_LT(person.result.inlier_ratio, 0.6 * clear.result.inlier_ratio);  // a weak match
+  EXPECT_LT(person.heading_error_deg, 0.5);
 }
 
 }  // namespace

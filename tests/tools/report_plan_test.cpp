@@ -261,6 +261,17 @@ TEST(ReportMapSizeTest, PlannedWithDistractorsAndRenderedFromItsJson) {
             std::string::npos)
       << command;
   EXPECT_LT(IndexOf(context.steps, "map-intel"), IndexOf(context.steps, "map-size-exact-1000"));
+  const std::vector<std::string> needs{ReportArtefacts::Map(context.settings, "fr079"),
+                                       FilesOf(context.settings, "fr079").corrected_log,
+                                       ReportArtefacts::Map(context.settings, "intel"),
+                                       ReportArtefacts::Map(context.settings, "fr101")};
+  EXPECT_EQ(step.needs, needs);
+  EXPECT_EQ(step.outputs, std::vector<std::string>{MapSizeJson(context.settings, "words", 10000)});
+  // Nothing has run: the table says how, and no empty figure is drawn.
+  context.figures_dir = (dir / "figures").string();
+  EXPECT_NE(MapSizeSection(context).find("figure: no map-size step has run yet"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "figures/map-size.png"));
 
   auto write = [&](const std::string& retrieval, int submaps, double seconds, double recall) {
     const std::string path = MapSizeJson(context.settings, retrieval, submaps);
@@ -272,7 +283,6 @@ TEST(ReportMapSizeTest, PlannedWithDistractorsAndRenderedFromItsJson) {
   };
   write("exact", 1000, 0.096, 0.95);
   write("words", 1000, 0.012, 0.90);
-  context.figures_dir = (dir / "figures").string();
   fs::create_directories(context.figures_dir);
   const std::string html = MapSizeSection(context);
   const bool figure = fs::exists(dir / "figures/map-size.png");

@@ -151,11 +151,13 @@ class ScanOdometry {
   /// recent matches' median inlier ratio) and parts from the prediction, per unit of the
   /// odometry's motion `odometry_step`, by many times the recent median (`agreement_window_`, the
   /// odometry's trust as measured online): a weak match that the trusted odometry contradicts.
-  bool WeakMatchContradictsOdometry(const IcpResult& icp, const Pose2& predicted_T_world_laser,
+  /// `correction`: ICP's pose in the predicted frame.
+  bool WeakMatchContradictsOdometry(double inlier_ratio, const Pose2& correction,
                                     const Pose2& odometry_step) const;
   /// Adds a registered step to `agreement_window_`.
-  void RecordAgreement(const ScanOdometryResult& result, const Pose2& predicted_T_world_laser,
-                       const Pose2& odometry_step);
+  void RecordAgreement(double inlier_ratio, const Pose2& correction, const Pose2& odometry_step);
+  /// Whether a scan at `T_world_laser` with `status` joins the local map.
+  bool WantsKeyframe(const Pose2& T_world_laser, ScanOdometryStatus status) const;
   /// The odometry's total over `odometry_window_` (not empty) applied to its oldest pose.
   Pose2 OdometryTotal(const Pose2& odometry_laser) const;
   /// The odometry's total over `odometry_window_` applied to its oldest pose, when the window is
@@ -171,9 +173,10 @@ class ScanOdometry {
                                        const std::optional<Pose2>& total) const;
   /// ICP from the prediction, its checks and the recovery: the scan's pose (the prediction when
   /// it falls back), with the status and ICP figures written to `result`.
+  /// `odometry_step`: the odometry's increment since the previous scan (laser frame).
   Pose2 Register(const std::vector<Eigen::Vector2d>& points, const Pose2& predicted_T_world_laser,
-                 const std::optional<Pose2>& disputing_motion, const Pose2& odometry_laser,
-                 ScanOdometryResult& result) const;
+                 const Pose2& odometry_step, const std::optional<Pose2>& disputing_motion,
+                 const Pose2& odometry_laser, ScanOdometryResult& result) const;
   /// The previous ICP step repeated (constant velocity) when it parts from the odometry's
   /// prediction by more than the correction bounds (recovery on, odometry at this scan and the
   /// one before, the last scan converged); nullopt otherwise.
