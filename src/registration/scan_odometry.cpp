@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/quantile.hpp"
 #include "correlative_search.hpp"
 
 namespace keyplace {
@@ -45,13 +46,6 @@ void RequireOdometryField(bool condition, const char* field, const char* what) {
 double DisagreementPerMotion(const Pose2& correction, const Pose2& odometry_step) {
   const double motion = TranslationNorm(odometry_step) + std::abs(odometry_step.theta);
   return (TranslationNorm(correction) + std::abs(correction.theta)) / (motion + kDisagreementFloor);
-}
-
-// The upper median (no average of the middle two: the values only bound a test).
-double Median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 void RecordIcp(const IcpResult& icp, ScanOdometryResult* result) {
@@ -221,15 +215,15 @@ bool ScanOdometry::WithinCorrectionBounds(const Pose2& correction) const {
 bool ScanOdometry::WeakMatchContradictsOdometry(double inlier_ratio, const Pose2& correction,
                                                 const Pose2& odometry_step) const {
   if (agreement_window_.size() < kAgreementMinScans) return false;
-  std::vector<double> ratios;
-  std::vector<double> disagreements;
-  for (const Agreement& a : agreement_window_) {
-    ratios.push_back(a.inlier_ratio);
-    disagreements.push_back(a.disagreement_per_motion);
-  }
-  if (inlier_ratio >= kWeakMatchInlierFraction * Median(ratios)) return false;
+  // Most matches are not weak: the disagreements' median only for those that are.
+  std::vector<double> values;
+  values.reserve(agreement_window_.size());
+  for (const Agreement& a : agreement_window_) values.push_back(a.inlier_ratio);
+  if (inlier_ratio >= kWeakMatchInlierFraction * Quantile(values, 0.5)) return false;
+  values.clear();
+  for (const Agreement& a : agreement_window_) values.push_back(a.disagreement_per_motion);
   return DisagreementPerMotion(correction, odometry_step) >
-         kContradictionMedians * Median(disagreements);
+         kContradictionMedians * Quantile(values, 0.5);
 }
 
 void ScanOdometry::RecordAgreement(double inlier_ratio, const Pose2& correction,

@@ -30,6 +30,16 @@ ReportSettings Settings(bool quick) {
   return settings;
 }
 
+// A page builder's context whose data and work directories lie in `dir` (emptied), FR079 only.
+ReportContext ContextIn(const fs::path& dir) {
+  fs::remove_all(dir);
+  ReportContext context;
+  context.settings.data_dir = (dir / "data").string();
+  context.settings.work_dir = (dir / "work").string();
+  context.settings.datasets = {"fr079"};
+  return context;
+}
+
 // The index of the step `id` in `steps` (steps.size() when absent).
 std::size_t IndexOf(const std::vector<ReportStep>& steps, const std::string& id) {
   const auto it =
@@ -146,11 +156,7 @@ TEST(ReportPlanTest, RelocalizeStepsWithoutDataAreSkipped) {
 
 TEST(ReportTablesTest, KidnappedRobotTableRendersTheJsonAndNamesWhatIsMissing) {
   const fs::path dir = fs::temp_directory_path() / "keyplace_report_tables_test";
-  fs::remove_all(dir);
-  ReportContext context;
-  context.settings.data_dir = (dir / "data").string();
-  context.settings.work_dir = (dir / "work").string();
-  context.settings.datasets = {"fr079"};
+  ReportContext context = ContextIn(dir);
   context.steps = PlanReport(context.settings);
   context.outcomes.resize(context.steps.size());
   const std::string path = ReportArtefacts::Relocalize(context.settings, "fr079", false);
@@ -183,11 +189,7 @@ TEST(ReportTablesTest, KidnappedRobotTableRendersTheJsonAndNamesWhatIsMissing) {
 // are in the data directory, and its section shows the relation error beside the published ones.
 TEST(ReportHospitalTest, PlannedWhenTheBagExistsAndRenderedFromItsJson) {
   const fs::path dir = fs::temp_directory_path() / "keyplace_report_hospital_test";
-  fs::remove_all(dir);
-  ReportContext context;
-  context.settings.data_dir = (dir / "data").string();
-  context.settings.work_dir = (dir / "work").string();
-  context.settings.datasets = {"fr079"};
+  ReportContext context = ContextIn(dir);
   auto planned = [&](bool quick) {
     ReportSettings settings = context.settings;
     settings.quick = quick;
@@ -235,11 +237,7 @@ TEST(ReportHospitalTest, PlannedWhenTheBagExistsAndRenderedFromItsJson) {
 // table with the exact / words ratio and a figure.
 TEST(ReportMapSizeTest, PlannedWithDistractorsAndRenderedFromItsJson) {
   const fs::path dir = fs::temp_directory_path() / "keyplace_report_map_size_test";
-  fs::remove_all(dir);
-  ReportContext context;
-  context.settings.data_dir = (dir / "data").string();
-  context.settings.work_dir = (dir / "work").string();
-  context.settings.datasets = {"fr079"};
+  ReportContext context = ContextIn(dir);
   context.settings.quick = true;
   EXPECT_TRUE(PlanMapSizeSteps(context.settings).empty());  // no other building to copy
   EXPECT_NE(MapSizeSection(context).find("needs FR079 and at least one other data set"),
