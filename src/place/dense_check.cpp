@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 
 namespace keyplace {
@@ -89,6 +90,44 @@ DenseReference::DenseReference(const std::vector<Eigen::Vector2i>& cells, double
     flags_[static_cast<std::size_t>(cj) * static_cast<std::size_t>(width_) +
            static_cast<std::size_t>(ci)] |= kOccupied;
   }
+  blocks_wide_ = (width_ + kBlockCells - 1) / kBlockCells;
+  const int blocks_high = (height_ + kBlockCells - 1) / kBlockCells;
+  block_occupied_.assign(static_cast<std::size_t>(blocks_wide_) * blocks_high, 0);
+  for (const Eigen::Vector2i& cell : cells) {
+    const int bi = (cell.x() - min_cell_.x() + margin_) / kBlockCells;
+    const int bj = (cell.y() - min_cell_.y() + margin_) / kBlockCells;
+    block_occupied_[static_cast<std::size_t>(bj) * blocks_wide_ + bi] = 1;
+  }
+}
+
+double DenseReference::EmptyBlockExit(const Eigen::Vector2d& origin_m,
+                                      const Eigen::Vector2d& direction,
+                                      const Eigen::Vector2d& point_m, double s_m) const {
+  // Far beyond the rounding of any sample's position (about 1e-13 m within a few km), so that a
+  // sample the exact geometry puts inside the block shrunk by this margin is computed inside it.
+  constexpr double kBlockMarginM = 1e-6;
+  const double cell_i = std::floor(point_m.x() / cell_size_m_) - min_cell_.x() + margin_;
+  const double cell_j = std::floor(point_m.y() / cell_size_m_) - min_cell_.y() + margin_;
+  if (!(cell_i >= 0.0 && cell_j >= 0.0 && cell_i < width_ && cell_j < height_)) return s_m;
+  const int bi = static_cast<int>(cell_i) / kBlockCells;
+  const int bj = static_cast<int>(cell_j) / kBlockCells;
+  if (block_occupied_[static_cast<std::size_t>(bj) * blocks_wide_ + bi]) return s_m;
+  const Eigen::Vector2d block_min = (Eigen::Vector2d(bi * kBlockCells, bj * kBlockCells) -
+                                     Eigen::Vector2d(margin_, margin_) + min_cell_.cast<double>()) *
+                                        cell_size_m_ +
+                                    Eigen::Vector2d::Constant(kBlockMarginM);
+  const Eigen::Vector2d block_max =
+      block_min + Eigen::Vector2d::Constant(kBlockCells * cell_size_m_ - 2.0 * kBlockMarginM);
+  double exit = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 2; ++axis) {
+    if (!(point_m[axis] > block_min[axis] && point_m[axis] < block_max[axis])) return s_m;
+    if (direction[axis] > 0.0) {
+      exit = std::min(exit, (block_max[axis] - origin_m[axis]) / direction[axis]);
+    } else if (direction[axis] < 0.0) {
+      exit = std::min(exit, (block_min[axis] - origin_m[axis]) / direction[axis]);
+    }
+  }
+  return exit;
 }
 
 std::uint8_t DenseReference::FlagsAt(const Eigen::Vector2d& point_m) const {
@@ -151,10 +190,16 @@ bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::V
   for (std::int64_t k = first; k <= last; ++k) {
     const double s = static_cast<double>(k) * step;
     if (s < 0.0 || s >= free_length) continue;
-    const Probe probe = ProbeAt(origin_m + s * direction);
+    const Eigen::Vector2d sample = origin_m + s * direction;
+    const Probe probe = ProbeAt(sample);
     if (!probe.inside) continue;
     crossed = true;
-    if (!(probe.flags & kOccupied)) continue;
+    if (!(probe.flags & kOccupied)) {
+      // The samples before the empty block's exit are neither occupied nor needed for `crossed`.
+      const double exit = EmptyBlockExit(origin_m, direction, sample, s);
+      if (exit > s) k = std::max(k, static_cast<std::int64_t>(std::ceil(exit / step)) - 1);
+      continue;
+    }
     const double beyond = s + kDenseWallCrossingM;
     if (beyond < free_length && !(FlagsAt(origin_m + beyond * direction) & kNearOccupied)) {
       return true;
@@ -165,26 +210,55 @@ bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::V
 
 DenseScore DenseReference::Score(const Pose2& T_ref_query,
                                  const std::vector<QueryScanPoints>& scans) const {
+  DenseVeto never;
+  never.min_endpoints = std::numeric_limits<int>::max();
+  return Score(T_ref_query, scans, never);
+}
+
+DenseScore DenseReference::Score(const Pose2& T_ref_query,
+                                 const std::vector<QueryScanPoints>& scans,
+                                 const DenseVeto& veto) const {
   DenseScore score;
   if (empty()) return score;
+  std::size_t beams = 0;
+  for (const QueryScanPoints& scan : scans) beams += scan.endpoints_m.size();
+  std::vector<Eigen::Vector2d> endpoints;
+  endpoints.reserve(beams);
   int hits = 0;
-  int seen_through = 0;
   for (const QueryScanPoints& scan : scans) {
-    const Eigen::Vector2d origin = T_ref_query * scan.origin_m;
     for (const Eigen::Vector2d& endpoint_query : scan.endpoints_m) {
-      const Eigen::Vector2d endpoint = T_ref_query * endpoint_query;
-      const Probe probe = ProbeAt(endpoint);
+      endpoints.push_back(T_ref_query * endpoint_query);
+      const Probe probe = ProbeAt(endpoints.back());
       if (probe.inside) {
         ++score.endpoints;
         if (probe.flags & kNearOccupied) ++hits;
       }
-      bool crossed = false;
-      if (SeesThrough(origin, endpoint, crossed)) ++seen_through;
-      if (crossed) ++score.rays;
     }
   }
   if (score.endpoints > 0) score.hit_fraction = static_cast<double>(hits) / score.endpoints;
+  const bool applies = score.endpoints >= veto.min_endpoints;
+  if (applies && score.hit_fraction < veto.min_hit_fraction) {
+    score.vetoed = true;
+    return score;
+  }
+  // seen_through / rays >= seen_through / beams: beyond this count the veto is certain.
+  const double certain_see_through = veto.max_see_through * static_cast<double>(beams);
+  int seen_through = 0;
+  std::size_t k = 0;
+  for (const QueryScanPoints& scan : scans) {
+    const Eigen::Vector2d origin = T_ref_query * scan.origin_m;
+    for (std::size_t b = 0; b < scan.endpoints_m.size(); ++b, ++k) {
+      bool crossed = false;
+      if (SeesThrough(origin, endpoints[k], crossed)) ++seen_through;
+      if (crossed) ++score.rays;
+      if (applies && seen_through > certain_see_through) {
+        score.vetoed = true;
+        return score;
+      }
+    }
+  }
   if (score.rays > 0) score.see_through_fraction = static_cast<double>(seen_through) / score.rays;
+  score.vetoed = applies && score.see_through_fraction > veto.max_see_through;
   return score;
 }
 

@@ -311,7 +311,11 @@ void ScoreDense(const Verification& v, int place_index, const std::vector<int>& 
   }
   const DenseReference reference = ReferenceOccupancy(v.places, place_index, neighbours);
   if (reference.empty()) return;
-  result.dense = reference.Score(T_ref_query, v.query.scans);
+  DenseVeto veto;
+  veto.min_endpoints = kDenseMinEndpoints;
+  veto.min_hit_fraction = v.config.dense_min_hit_fraction;
+  veto.max_see_through = v.config.dense_max_see_through;
+  result.dense = reference.Score(T_ref_query, v.query.scans, veto);
   result.dense_checked = true;
 }
 
@@ -364,19 +368,16 @@ std::optional<CandidateResult> VerifyCandidate(const Verification& v, const Cand
   const int consensus = CountConsensus(estimate.inliers, config.consensus_counting);
   if (consensus < config.min_consensus) return std::nullopt;  // first check
   CandidateResult result;
+  // Second check. Where enough of the query's beams fall in the candidate's area they veto a
+  // pose that puts them off its walls or through them, and a pose they confirm beyond doubt
+  // needs no gamma (sparse stable keypoints make gamma small in open halls); elsewhere gamma.
   ScoreDense(v, candidate.place_index, neighbours, estimate.T_ref_cur, result);
+  if (result.dense.vetoed) return std::nullopt;
+  const bool dense_applies = result.dense_checked && result.dense.endpoints >= kDenseMinEndpoints;
   const GammaResult gamma =
       ComputeGamma(*reference_positions, *reference_descriptors, v.query.positions,
                    v.query.descriptors, estimate.T_ref_cur, config.double_match_m,
                    config.descriptor_match_chi2, config.gamma_counting);
-  // Second check. Where enough of the query's beams fall in the candidate's area they veto a
-  // pose that puts them off its walls or through them, and a pose they confirm beyond doubt
-  // needs no gamma (sparse stable keypoints make gamma small in open halls); elsewhere gamma.
-  const bool dense_applies = result.dense_checked && result.dense.endpoints >= kDenseMinEndpoints;
-  if (dense_applies && (result.dense.hit_fraction < config.dense_min_hit_fraction ||
-                        result.dense.see_through_fraction > config.dense_max_see_through)) {
-    return std::nullopt;
-  }
   result.dense_sure = dense_applies &&
                       result.dense.hit_fraction >= config.dense_sure_hit_fraction &&
                       result.dense.see_through_fraction <= config.dense_sure_see_through;

@@ -110,6 +110,41 @@ TEST(SymmetricChi2, EarlyExitAgreesWithFullSum) {
   }
 }
 
+// The distance, term by term and in bin order, as FLIRTLib writes it (empty bins replaced by the
+// smallest normal double): the packed terms of descriptor.cpp must give its sums bit for bit, or
+// pairs at the threshold and the order of equal pairs would change.
+double ScalarSymmetricChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b) {
+  constexpr double kZero = std::numeric_limits<double>::min();
+  double sum = 0.0;
+  for (int i = 0; i < kBetaGridBins; ++i) {
+    const double q = a[i] > 0.0f ? static_cast<double>(a[i]) : kZero;
+    const double p = b[i] > 0.0f ? static_cast<double>(b[i]) : kZero;
+    sum += (q - p) * (q - p) / (q + p);
+  }
+  return 0.5 * sum;
+}
+
+TEST(SymmetricChi2, EqualsTheScalarSumBitForBit) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  for (int trial = 0; trial < 2000; ++trial) {
+    BetaGridDescriptor a, b;
+    for (int i = 0; i < kBetaGridBins; ++i) {
+      // Half-empty, as real descriptors are, with bins of very different sizes.
+      a[i] = uniform(rng) < 0.5f ? 0.0f : std::pow(uniform(rng), 4.0f);
+      b[i] = uniform(rng) < 0.5f ? 0.0f : std::pow(uniform(rng), 4.0f);
+    }
+    const double expected = ScalarSymmetricChi2(a, b);
+    ASSERT_EQ(SymmetricChi2(a, b), expected) << "trial " << trial;
+    // Just above the distance the pair is below, at it not: the early exit stops exactly there.
+    ASSERT_EQ(SymmetricChi2IfBelow(a, b, std::nextafter(expected, 10.0)), expected)
+        << "trial " << trial;
+    ASSERT_TRUE(std::isinf(SymmetricChi2IfBelow(a, b, expected))) << "trial " << trial;
+    ASSERT_EQ(SymmetricChi2Below(a, b, std::nextafter(expected, 10.0)), true);
+    ASSERT_EQ(SymmetricChi2Below(a, b, expected), false);
+  }
+}
+
 TEST(FlirtExtractor, CornerYieldsKeypointNearCorner) {
   const LaserScan scan = CornerScan();
   const FlirtExtractor extractor;

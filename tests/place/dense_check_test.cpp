@@ -5,8 +5,10 @@
 #include "keyplace/place/dense_check.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
@@ -132,6 +134,118 @@ TEST(DenseReference, EndpointsOutsideTheReferenceCountForNothing) {
   EXPECT_EQ(through.see_through_fraction, 1.0);
   EXPECT_TRUE(DenseReference({}, 0.1).empty());
   EXPECT_THROW(DenseReference({}, 0.0), std::invalid_argument);
+}
+
+// The see-through walk as documented, sample by sample over the whole beam (no clipping to the
+// occupied box, no skipping of empty blocks): a beam crossed the reference when one of its samples
+// every half cell, short of kDenseSeeThroughMarginM before its endpoint, falls in the occupied
+// cells' box, and saw through when such a sample is occupied and the point kDenseWallCrossingM
+// further on is more than kDenseHitDistanceM (two cells) from every occupied cell.
+struct NaiveRays {
+  int rays = 0;
+  int seen_through = 0;
+};
+NaiveRays NaiveWalk(const std::vector<Eigen::Vector2i>& cells, const Pose2& T_ref_query,
+                    const std::vector<QueryScanPoints>& scans) {
+  constexpr double kCell = 0.1;
+  std::set<std::pair<int, int>> occupied;
+  Eigen::Vector2i lo = cells.front();
+  Eigen::Vector2i hi = cells.front();
+  for (const Eigen::Vector2i& c : cells) {
+    occupied.emplace(c.x(), c.y());
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  const auto cell_of = [](const Eigen::Vector2d& p) {
+    return std::pair<double, double>(std::floor(p.x() / kCell), std::floor(p.y() / kCell));
+  };
+  const auto near_occupied = [&](const Eigen::Vector2d& p) {
+    const auto [i, j] = cell_of(p);
+    for (int di = -2; di <= 2; ++di) {
+      for (int dj = -2; dj <= 2; ++dj) {
+        if (di * di + dj * dj <= 4 &&
+            occupied.count({static_cast<int>(i) + di, static_cast<int>(j) + dj}) > 0) {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  NaiveRays out;
+  for (const QueryScanPoints& scan : scans) {
+    const Eigen::Vector2d origin = T_ref_query * scan.origin_m;
+    for (const Eigen::Vector2d& endpoint_query : scan.endpoints_m) {
+      const Eigen::Vector2d endpoint = T_ref_query * endpoint_query;
+      const double length = (endpoint - origin).norm();
+      const double free_length = length - kDenseSeeThroughMarginM;
+      if (!(free_length > 0.0)) continue;
+      const Eigen::Vector2d direction = (endpoint - origin) / length;
+      bool crossed = false;
+      bool through = false;
+      for (std::int64_t k = 0; !through; ++k) {
+        const double s = static_cast<double>(k) * 0.5 * kCell;
+        if (s >= free_length) break;
+        const auto [i, j] = cell_of(origin + s * direction);
+        if (i < lo.x() || i > hi.x() || j < lo.y() || j > hi.y()) continue;
+        crossed = true;
+        if (occupied.count({static_cast<int>(i), static_cast<int>(j)}) == 0) continue;
+        const double beyond = s + kDenseWallCrossingM;
+        through = beyond < free_length && !near_occupied(origin + beyond * direction);
+      }
+      out.rays += crossed ? 1 : 0;
+      out.seen_through += through ? 1 : 0;
+    }
+  }
+  return out;
+}
+
+// Score walks only the box's stretch of each beam and jumps over blocks without walls, and with a
+// veto it stops once the veto is certain: the counts must be the plain walk's, and a pose is
+// vetoed exactly when the full score meets the veto.
+TEST(DenseReference, ShortcutsGiveThePlainWalksScore) {
+  const std::vector<Eigen::Vector2i> cells = OccupiedCells(Room(), kMapPoses);
+  const DenseReference reference(cells, 0.1);
+  const std::vector<QueryScanPoints> scans = QueryScans(Room(), kQueryPoses);
+  const Pose2 T_true = Between(kMapPoses.front(), kQueryPoses.front());
+  DenseVeto veto;
+  veto.min_endpoints = 50;
+  veto.min_hit_fraction = 0.5;
+  veto.max_see_through = 0.3;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> metres(0.0, 0.6);
+  std::normal_distribution<double> radians(0.0, 0.5);
+  int vetoed = 0;
+  int through_some_wall = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const Pose2 T_ref_query =
+        trial == 0 ? T_true : Pose2(metres(rng), metres(rng), radians(rng)) * T_true;
+    const DenseScore score = reference.Score(T_ref_query, scans);
+    const NaiveRays naive = NaiveWalk(cells, T_ref_query, scans);
+    ASSERT_EQ(score.rays, naive.rays) << "trial " << trial;
+    ASSERT_EQ(score.see_through_fraction,
+              naive.rays > 0 ? static_cast<double>(naive.seen_through) / naive.rays : 0.0)
+        << "trial " << trial;
+    through_some_wall += naive.seen_through > 0 ? 1 : 0;
+
+    const DenseScore with_veto = reference.Score(T_ref_query, scans, veto);
+    const bool should_veto = score.endpoints >= veto.min_endpoints &&
+                             (score.hit_fraction < veto.min_hit_fraction ||
+                              score.see_through_fraction > veto.max_see_through);
+    ASSERT_EQ(with_veto.vetoed, should_veto) << "trial " << trial;
+    EXPECT_FALSE(score.vetoed);
+    if (should_veto) {
+      ++vetoed;
+      continue;
+    }
+    EXPECT_EQ(with_veto.endpoints, score.endpoints);
+    EXPECT_EQ(with_veto.hit_fraction, score.hit_fraction);
+    EXPECT_EQ(with_veto.rays, score.rays);
+    EXPECT_EQ(with_veto.see_through_fraction, score.see_through_fraction);
+  }
+  // Both kinds of pose were met, and walls were seen through.
+  EXPECT_GT(vetoed, 10);
+  EXPECT_LT(vetoed, 59);
+  EXPECT_GT(through_some_wall, 10);
 }
 
 // Keypoints on the room's walls with distinct descriptors, in the place frame (kMapPoses[0]).

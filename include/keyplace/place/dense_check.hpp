@@ -56,6 +56,18 @@ struct DenseScore {
   // that crosses an occupied reference cell more than kDenseSeeThroughMarginM short of it.
   int rays = 0;
   double see_through_fraction = 0.0;
+  // Set by the Score that takes a DenseVeto when the veto is certain; the score stopped there, so
+  // its fractions are those of what it had looked at.
+  bool vetoed = false;
+};
+
+/// When the beams veto a pose: at least `min_endpoints` endpoints inside the reference's area and
+/// fewer than `min_hit_fraction` of them hitting it, or more than `max_see_through` of the rays
+/// crossing it seeing through (PlaceRecognitionConfig::dense_*).
+struct DenseVeto {
+  int min_endpoints = 0;
+  double min_hit_fraction = 0.0;
+  double max_see_through = 1.0;
 };
 
 // An endpoint within this of an occupied cell (of 0.1 m) hits it: two cells, the mapping grid's
@@ -75,6 +87,13 @@ class DenseReference {
 
   /// The query scans put into the reference frame by T_ref_query.
   DenseScore Score(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans) const;
+
+  /// The same, stopping as soon as `veto` is certain (DenseScore::vetoed): the endpoints are
+  /// scored before any beam is traced, and tracing ends once more beams saw through than the
+  /// veto allows of all of them. A pose not vetoed gets Score's result exactly; most candidates
+  /// of a query are vetoed, mostly by their endpoints, and tracing is most of the cost.
+  DenseScore Score(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
+                   const DenseVeto& veto) const;
 
   /// Score's endpoints and hit_fraction alone (no beam is traced), from every `stride`-th
   /// endpoint: cheap enough to compare thousands of poses.
@@ -96,6 +115,12 @@ class DenseReference {
   Probe ProbeAt(const Eigen::Vector2d& point_m) const;
   bool SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::Vector2d& endpoint_m,
                    bool& crossed) const;
+  // Where the beam from origin_m along direction (unit) leaves the block of kBlockCells² raster
+  // cells holding `point_m` (at parameter s_m), when that block holds no occupied cell: every
+  // sample before the returned parameter lies in the block, so none can be occupied. s_m itself
+  // when the block is occupied or the point lies within kBlockMarginM of its border.
+  double EmptyBlockExit(const Eigen::Vector2d& origin_m, const Eigen::Vector2d& direction,
+                        const Eigen::Vector2d& point_m, double s_m) const;
 
   double cell_size_m_ = 0.1;
   Eigen::Vector2i min_cell_ = Eigen::Vector2i::Zero();  // of the occupied cells
@@ -104,6 +129,11 @@ class DenseReference {
   int height_ = 0;
   int margin_ = 0;  // raster cells around the occupied box
   std::vector<std::uint8_t> flags_;
+  // Blocks of kBlockCells x kBlockCells raster cells holding an occupied cell: a beam crosses the
+  // empty ones (most of a room's free space) without a sample per half cell.
+  static constexpr int kBlockCells = 8;
+  int blocks_wide_ = 0;
+  std::vector<char> block_occupied_;
 };
 
 }  // namespace keyplace
