@@ -46,6 +46,12 @@ void Validate(const FixPolicy& policy) {
   if (policy.confirmations < 1) {
     throw std::invalid_argument("FixPolicy.confirmations must be >= 1");
   }
+  if (policy.weak_fix_answers < 0) {
+    throw std::invalid_argument("FixPolicy.weak_fix_answers must be >= 0");
+  }
+  if (!(policy.weak_fix_span_m >= 0.0) || !std::isfinite(policy.weak_fix_span_m)) {
+    throw std::invalid_argument("FixPolicy.weak_fix_span_m must be finite and >= 0");
+  }
   const auto require_positive = [](double value, const char* name) {
     if (!(value > 0.0) || !std::isfinite(value)) {
       throw std::invalid_argument(std::string("FixPolicy.") + name +

@@ -13,6 +13,11 @@ const ConfigFields<FixPolicy>& FixPolicyFields() {
     table
         .Int("confirmations", &C::confirmations, "",
              "answers that must agree through odometry before a fix (one accepted)")
+        .Int("weak_fix_answers", &C::weak_fix_answers, "",
+             "weak answers alone make a fix when this many agree through odometry (0 = never) "
+             "...")
+        .Double("weak_fix_span_m", &C::weak_fix_span_m, "m",
+                "... from looks this far apart (odometry), first to last")
         .Double("agree_m", &C::agree_m, "m", "two answers agree within this distance (now) ...")
         .Double("agree_per_m", &C::agree_per_m, "m/m",
                 "... plus this per metre travelled between them (odometry drift)")

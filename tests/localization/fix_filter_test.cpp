@@ -218,8 +218,8 @@ TEST(FixFilter, OneConfirmationFixesAtOnce) {
 }
 
 // Weak answers second an accepted one from another look (more than agree_m of odometry away):
-// alone, however many agree, they make no fix.
-TEST(FixFilter, WeakAnswersAloneNeverMakeAFix) {
+// alone, however many agree within a room's span (weak_fix_span_m), they make no fix.
+TEST(FixFilter, WeakAnswersWithinARoomMakeNoFixAlone) {
   FixFilter filter;
   EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 1), Odometry(0)).status, FixStatus::kSearching);
   EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 2), Odometry(3)).status, FixStatus::kSearching);
@@ -229,6 +229,44 @@ TEST(FixFilter, WeakAnswersAloneNeverMakeAFix) {
   EXPECT_TRUE(update.new_fix);
   // The accepted answer and the three weak ones, each more than agree_m from it.
   EXPECT_NEAR(update.confidence, 1.0 - 0.5 * 0.95 * 0.95 * 0.95, 1e-12);
+}
+
+// Three weak answers of different looks that agree along more than weak_fix_span_m make a fix:
+// the pose keeps explaining what the robot sees over a path longer than a room.
+TEST(FixFilter, WeakAnswersAgreeingAlongAPathLongerThanARoomMakeAFix) {
+  FixFilter filter;
+  ASSERT_EQ(FixPolicy{}.weak_fix_answers, 3);
+  ASSERT_EQ(FixPolicy{}.weak_fix_span_m, 10.0);
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 1), Odometry(0)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 2), Odometry(20)).status, FixStatus::kSearching);
+  // Three looks, but only 9.75 m from the first to the last.
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 3), Odometry(39)).status, FixStatus::kSearching);
+  const Pose2 latest = kTrue * Pose2(0.2, 0.0, 0.01);
+  const RelocalizationUpdate update = filter.Update(WeakAnswer(latest, 4), Odometry(44));
+  ASSERT_EQ(update.status, FixStatus::kFixed);
+  EXPECT_TRUE(update.new_fix);
+  EXPECT_NEAR(update.T_world_odom.x, latest.x, 1e-9);  // the newest answer's pose
+  // Four weak answers of confidence 0.05 each: a fix of low confidence, as its evidence is.
+  EXPECT_NEAR(update.confidence, 1.0 - std::pow(0.95, 4), 1e-12);
+}
+
+TEST(FixFilter, WeakAnswersThatDisagreeOrAreTooFewMakeNoFix) {
+  // Two looks 12 m apart agree, a third in between names another pose.
+  FixFilter filter;
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kWrong, 2), Odometry(24));
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 3), Odometry(48)).status, FixStatus::kSearching);
+  // A third look that agrees completes them.
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 4), Odometry(56)).new_fix);
+
+  // Off (0): weak answers only second accepted ones, however many and far apart.
+  FixPolicy never;
+  never.weak_fix_answers = 0;
+  FixFilter off(never);
+  for (int look = 0; look < 5; ++look) {
+    EXPECT_EQ(off.Update(WeakAnswer(kTrue, look), Odometry(12 * look)).status,
+              FixStatus::kSearching);
+  }
 }
 
 TEST(FixFilter, AWeakAnswerFromAnotherLookSecondsAnAcceptedOne) {
@@ -294,6 +332,12 @@ TEST(FixFilter, RejectsInvalidPolicies) {
   EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
   policy = {};
   policy.contradiction_confidence = 1.5;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+  policy = {};
+  policy.weak_fix_answers = -1;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+  policy = {};
+  policy.weak_fix_span_m = -1.0;
   EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
 }
 
