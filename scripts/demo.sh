@@ -36,7 +36,8 @@ echo "..."
 tail -1 "$out/localize-stream.txt"
 echo
 echo "== Kidnapped robot on a map recorded earlier: the map of the first half of the log, 12 starts"
-echo "   in the second half; the Relocalizer fixes when two answers agree (keyplace relocalize)"
+echo "   in the second half; the Relocalizer fixes when answers agree (two, one accepted, or three"
+echo "   weak ones along 10 m: keyplace relocalize)"
 "$keyplace" map "$log" --scans 0:732 --out "$out/map-first-half.kpm" >/dev/null
 "$keyplace" relocalize --map "$out/map-first-half.kpm" --log "$log" --scans 732: --starts 12 \
   --json "$out/relocalize.json" --figure "$out/relocalize.png" | sed -n '3,11p'

@@ -164,8 +164,9 @@ void RegisterRelocalizeCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "relocalize",
       "The kidnapped-robot benchmark: from --starts starts spread over the query log the "
-      "localizer, knowing nothing, is fed scans and odometry until two answers agree on a fix "
-      "(or it gives up after evaluation.give_up_m of travel); it then runs evaluation.follow_m "
+      "localizer, knowing nothing, is fed scans and odometry until answers agree on a fix (two, "
+      "one of them accepted, or three weak ones along 10 m; docs/LOCALIZATION.md) (or it gives up "
+      "after evaluation.give_up_m of travel); it then runs evaluation.follow_m "
       "further and every fix it reports is checked against the truth (0.5 m, 10 deg). Without "
       "truth (no --truth, a log or bag without corrected poses) the log is relocalized once from "
       "its first scan as a robot would be: the status and pose at every scan (--fixes), the "
