@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "common/fixed_text.hpp"
 #include "keyplace/store/map_file.hpp"
 
 namespace keyplace {
@@ -51,6 +52,13 @@ void Validate(const FixPolicy& policy) {
   }
   if (!(policy.weak_fix_span_m >= 0.0) || !std::isfinite(policy.weak_fix_span_m)) {
     throw std::invalid_argument("FixPolicy.weak_fix_span_m must be finite and >= 0");
+  }
+  // Answers older than window_m are forgotten: a longer span could never be reached.
+  if (policy.weak_fix_answers > 0 && policy.weak_fix_span_m > policy.window_m) {
+    throw std::invalid_argument(
+        "FixPolicy.weak_fix_span_m (" + FixedText(policy.weak_fix_span_m) +
+        " m) must not exceed window_m (" + FixedText(policy.window_m) +
+        " m): older answers are forgotten; lower it, or set weak_fix_answers to 0");
   }
   const auto require_positive = [](double value, const char* name) {
     if (!(value > 0.0) || !std::isfinite(value)) {

@@ -102,6 +102,7 @@ void FixFilter::Reset() {
   hypotheses_.clear();
   challengers_.clear();
   fix_confidence_ = 0.0;
+  fix_weak_ = false;
   fix_variance_m2_ = 0.0;
   confirmed_at_m_ = 0.0;
   fix_covariance_.setZero();
@@ -219,10 +220,13 @@ void FixFilter::Search(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
 
 void FixFilter::Track(const Hypothesis& hypothesis, const Pose2& T_odom_robot,
                       RelocalizationUpdate& update) {
-  const Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_,
-                       FixCovarianceAt(T_odom_robot), T_odom_robot};
+  Hypothesis fix{T_world_odom_, fix_confidence_, confirmed_at_m_, FixCovarianceAt(T_odom_robot),
+                 T_odom_robot};
+  // After a confident contradiction the fix stays a hypothesis: one of weak answers alone
+  // counts as weak again.
+  fix.weak = fix_weak_;
   // A weak answer that agrees confirms the fix even from the spot of the last confirmation: the
-  // fix was made with an accepted answer, and a confirmation only averages within the agreement.
+  // fix was made by answers that agreed, and a confirmation only averages within the agreement.
   if (Agree(fix, hypothesis, T_odom_robot)) {
     Confirm(hypothesis, T_odom_robot);
     update.confirmed = true;
@@ -269,29 +273,35 @@ void FixFilter::Confirm(const Hypothesis& answer, const Pose2& T_odom_robot) {
   fix_variance_m2_ = std::max(fix_variance * answer_variance / (fix_variance + answer_variance),
                               answer_variance / 4.0);
   fix_confidence_ = CombinedConfidence({fix_confidence_, answer.confidence});
+  fix_weak_ = fix_weak_ && answer.weak;
   confirmed_at_m_ = odometry_m_;
   challengers_.clear();
 }
 
 // `confirmations` agreeing answers make a fix when one of them is accepted. Weak answers alone
-// need more of them, from looks spread along the path (FixPolicy::weak_fix_*): in the time split
-// of Intel (map of the first half, starts in the second) weak answers from several looks agreed
-// on rooms turned by 90 degrees (the lab's rooms look alike): two of them made 508 wrong fixes of
-// 2270, three within 3 m of odometry 443 of 2262.
+// need more looks, spread along the path (FixPolicy::weak_fix_*): in the time split of Intel (map
+// of the first half, starts in the second) weak answers from several looks agreed on rooms
+// turned by 90 degrees (the lab's rooms look alike): two of them made 508 wrong fixes of 2270,
+// three over a span of 3 m 443 of 2262.
 bool FixFilter::Enough(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest) const {
   const auto accepted = [](const Hypothesis& h) { return !h.weak; };
   const bool any_accepted =
       accepted(latest) || std::any_of(agreeing.begin(), agreeing.end(), accepted);
-  if (any_accepted) return static_cast<int>(agreeing.size()) + 1 >= policy_.confirmations;
+  if (any_accepted && static_cast<int>(agreeing.size()) + 1 >= policy_.confirmations) return true;
   if (policy_.weak_fix_answers == 0) return false;
-  double first_m = latest.odometry_m;
-  double last_m = latest.odometry_m;
-  for (const Hypothesis& h : agreeing) {
-    first_m = std::min(first_m, h.odometry_m);
-    last_m = std::max(last_m, h.odometry_m);
+  // Looks: answers more than agree_m of odometry after the previous look (Agreeing keeps each
+  // that far from the latest only; two answers from nearly one spot are one look).
+  std::vector<double> at_m{latest.odometry_m};
+  for (const Hypothesis& h : agreeing) at_m.push_back(h.odometry_m);
+  std::sort(at_m.begin(), at_m.end());
+  int looks = 1;
+  double look_m = at_m.front();
+  for (const double m : at_m) {
+    if (m - look_m <= policy_.agree_m) continue;
+    ++looks;
+    look_m = m;
   }
-  return static_cast<int>(agreeing.size()) + 1 >= policy_.weak_fix_answers &&
-         last_m - first_m >= policy_.weak_fix_span_m;
+  return looks >= policy_.weak_fix_answers && at_m.back() - at_m.front() >= policy_.weak_fix_span_m;
 }
 
 bool FixFilter::Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const {
@@ -361,6 +371,8 @@ void FixFilter::DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypoth
   fix_covariance_ = latest.covariance;
   fix_covariance_at_ = latest.T_odom_robot;
   fix_confidence_ = CombinedConfidence(confidences);
+  fix_weak_ = latest.weak && std::all_of(agreeing.begin(), agreeing.end(),
+                                         [](const Hypothesis& h) { return h.weak; });
   confirmed_at_m_ = odometry_m_;
   hypotheses_.clear();
   challengers_.clear();

@@ -241,8 +241,9 @@ DenseScore DenseReference::Score(const Pose2& T_ref_query,
     score.vetoed = true;
     return score;
   }
-  // seen_through / rays >= seen_through / beams: beyond this count the veto is certain.
-  const double certain_see_through = veto.max_see_through * static_cast<double>(beams);
+  // seen_through / rays >= seen_through / beams (each ray is a beam), and rounding keeps that
+  // order: once seen_through / beams exceeds the veto, the final fraction does too.
+  const auto beam_count = static_cast<double>(beams);
   int seen_through = 0;
   std::size_t k = 0;
   for (const QueryScanPoints& scan : scans) {
@@ -251,7 +252,7 @@ DenseScore DenseReference::Score(const Pose2& T_ref_query,
       bool crossed = false;
       if (SeesThrough(origin, endpoints[k], crossed)) ++seen_through;
       if (crossed) ++score.rays;
-      if (applies && seen_through > certain_see_through) {
+      if (applies && static_cast<double>(seen_through) / beam_count > veto.max_see_through) {
         score.vetoed = true;
         return score;
       }

@@ -124,6 +124,7 @@ TEST(FixFilter, OdometryDriftWidensAgreementWithDistance) {
 TEST(FixFilter, OldAnswersAreForgotten) {
   FixPolicy policy;
   policy.window_m = 5.0;
+  policy.weak_fix_span_m = 5.0;  // no longer than the window (Validate)
   FixFilter filter(policy);
   filter.Update(Answer(kTrue), Odometry(0));
   // 6 m later the first answer is gone: no fix from the second alone.
@@ -269,6 +270,40 @@ TEST(FixFilter, WeakAnswersThatDisagreeOrAreTooFewMakeNoFix) {
   }
 }
 
+// Two answers from nearly one spot (a robot turning on the spot) are one look, also when a third
+// lies far from both.
+TEST(FixFilter, WeakAnswersFromOneSpotAreOneLook) {
+  FixFilter filter;
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kTrue, 2), Odometry(2));  // 0.5 m on: the same look
+  EXPECT_EQ(filter.Update(WeakAnswer(kTrue, 3), Odometry(44)).status, FixStatus::kSearching);
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 4), Odometry(50)).new_fix);
+}
+
+// A fix of weak answers alone that a confident answer contradicts stays a hypothesis as weak as it
+// was: one more weak answer does not restore it, an accepted one does.
+TEST(FixFilter, AContradictedWeakFixNeedsAnAcceptedAnswerBack) {
+  FixFilter filter;
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kTrue, 2), Odometry(20));
+  ASSERT_TRUE(filter.Update(WeakAnswer(kTrue, 3), Odometry(44)).new_fix);
+  ASSERT_TRUE(filter.Update(AnswerOfQuery(kWrong, 4, 0.95), Odometry(48)).lost);
+  EXPECT_NE(filter.Update(WeakAnswer(kTrue, 5), Odometry(56)).status, FixStatus::kFixed);
+  const RelocalizationUpdate update = filter.Update(AnswerOfQuery(kTrue, 6), Odometry(64));
+  EXPECT_TRUE(update.new_fix);
+  EXPECT_NEAR(update.T_world_odom.x, kTrue.x, 1e-9);
+}
+
+// An accepted answer among the looks never makes a fix harder than weak answers alone.
+TEST(FixFilter, AnAcceptedLookCountsForTheWeakRuleToo) {
+  FixPolicy policy;
+  policy.confirmations = 4;
+  FixFilter filter(policy);
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(AnswerOfQuery(kTrue, 2), Odometry(20));
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 3), Odometry(44)).new_fix);
+}
+
 TEST(FixFilter, AWeakAnswerFromAnotherLookSecondsAnAcceptedOne) {
   FixFilter filter;
   filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
@@ -338,6 +373,9 @@ TEST(FixFilter, RejectsInvalidPolicies) {
   EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
   policy = {};
   policy.weak_fix_span_m = -1.0;
+  EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
+  policy = {};
+  policy.weak_fix_span_m = policy.window_m + 1.0;  // answers are forgotten before
   EXPECT_THROW(FixFilter{policy}, std::invalid_argument);
 }
 

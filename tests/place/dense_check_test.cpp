@@ -248,6 +248,35 @@ TEST(DenseReference, ShortcutsGiveThePlainWalksScore) {
   EXPECT_GT(through_some_wall, 10);
 }
 
+// Single occupied cells scattered over a hall, many of them just past the border of a skipped
+// block, and beams at every angle: a beam that jumped one sample too far would miss a cell the
+// plain walk enters (and, the cells being alone, sees through).
+TEST(DenseReference, ShortcutsMissNoSingleCell) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> cell(0, 159);
+  std::uniform_int_distribution<int> offset(-1, 1);
+  std::vector<Eigen::Vector2i> cells;
+  for (int k = 0; k < 150; ++k) cells.emplace_back(cell(rng), cell(rng));
+  // Around the borders of the 8-cell blocks (the raster starts 2 cells before the box).
+  for (int k = 0; k < 150; ++k) {
+    cells.emplace_back(8 * (cell(rng) / 8) + 6 + offset(rng), cell(rng));
+    cells.emplace_back(cell(rng), 8 * (cell(rng) / 8) + 6 + offset(rng));
+  }
+  const DenseReference reference(cells, 0.1);
+  std::uniform_real_distribution<double> metres(-2.0, 18.0);
+  std::vector<QueryScanPoints> scans(20);
+  for (QueryScanPoints& scan : scans) {
+    scan.origin_m = Eigen::Vector2d(metres(rng), metres(rng));
+    for (int b = 0; b < 100; ++b) scan.endpoints_m.emplace_back(metres(rng), metres(rng));
+  }
+  const DenseScore score = reference.Score(Pose2(), scans);
+  const NaiveRays naive = NaiveWalk(cells, Pose2(), scans);
+  EXPECT_EQ(score.rays, naive.rays);
+  ASSERT_GT(naive.rays, 1500);
+  EXPECT_GT(naive.seen_through, 300);
+  EXPECT_EQ(score.see_through_fraction, static_cast<double>(naive.seen_through) / naive.rays);
+}
+
 // Keypoints on the room's walls with distinct descriptors, in the place frame (kMapPoses[0]).
 BetaGridDescriptor Descriptor(int code) {
   BetaGridDescriptor d{};

@@ -36,14 +36,15 @@ struct FixPolicy {
   // others may be weak: LocalizationResult::weak_T_world_odom); 1: every accepted answer is a
   // fix. Weak answers alone: weak_fix_answers below.
   int confirmations = 2;
-  // Weak answers alone make a fix when at least `weak_fix_answers` of them, from different looks,
-  // agree through odometry and the looks lie at least `weak_fix_span_m` of odometry apart, first
-  // to last: a pose that keeps explaining what the robot sees along a path longer than a room.
-  // Look-alike rooms (Intel's lab, turned by 90 degrees) give weak answers that agree over a
-  // few metres; an open hall, whose sparse keypoints make most right answers weak, gives them
-  // along the whole drive. 0 = never (weak answers only second an accepted one). Chosen on
-  // Intel and FR079 (time split): with 3 answers the shortest span without a wrong fix is 5 m
-  // (4 m: 26 wrong fixes on Intel); the default is twice that (docs/LOCALIZATION.md).
+  // Weak answers alone make a fix when at least `weak_fix_answers` looks (answers more than
+  // agree_m of odometry after the previous look) agree through odometry and lie at least
+  // `weak_fix_span_m` of odometry apart, first to last (at most window_m): a pose that keeps
+  // explaining what the robot sees along a path longer than a room. Look-alike rooms (Intel's lab,
+  // turned by 90 degrees) give weak answers that agree over a few metres; an open hall, whose
+  // sparse keypoints make most right answers weak, gives them along the whole drive. 0 = never
+  // (weak answers only second an accepted one). Chosen on Intel and FR079 (time split): with 3
+  // answers the shortest span without a wrong fix is 5 m (4 m: 26 wrong fixes on Intel); the
+  // default is twice that (docs/LOCALIZATION.md).
   int weak_fix_answers = 3;
   double weak_fix_span_m = 10.0;
   // Two answers agree when they put the robot now within agree_m + agree_per_m * (odometry

@@ -148,6 +148,7 @@ class FixFilter {
   long long self_contradicted_query_ = -1;
   Pose2 T_world_odom_;  // the fix
   double fix_confidence_ = 0.0;
+  bool fix_weak_ = false;  // made by weak answers alone and confirmed by no accepted one since
   double fix_variance_m2_ = 0.0;  // of the fix's position at its last confirmation
   double confirmed_at_m_ = 0.0;   // odometry distance of the last confirmation
   // Covariance of the fix (robot pose in the map) at odometry pose fix_covariance_at_, at the last
