@@ -67,22 +67,13 @@ double SymmetricChi2(const BetaGridDescriptor& a, const BetaGridDescriptor& b) {
 
 bool SymmetricChi2Below(const BetaGridDescriptor& a, const BetaGridDescriptor& b,
                         double threshold) {
-  const double limit = 2.0 * threshold;  // compare the raw sum, halve nothing in the loop
-  double sum = 0.0;
-  double terms[kBetaGridRhoBins];
-  for (int phi = 0; phi < kBetaGridPhiBins; ++phi) {
-    const int base = phi * kBetaGridRhoBins;
-    SectorTerms(a.data() + base, b.data() + base, terms);
-    for (int rho = 0; rho < kBetaGridRhoBins; ++rho) sum += terms[rho];
-    if (sum >= limit) return false;
-  }
-  return 0.5 * sum < threshold;
+  return SymmetricChi2IfBelow(a, b, threshold) < threshold;  // +inf when not below
 }
 
 double SymmetricChi2IfBelow(const BetaGridDescriptor& a, const BetaGridDescriptor& b,
                             double threshold) {
   // The sum of SymmetricChi2 in its order; partial sums never decrease (non-negative terms), so
-  // stopping where SymmetricChi2Below stops rejects exactly the pairs it rejects.
+  // stopping once the raw sum reaches twice the threshold rejects no pair below it.
   const double limit = 2.0 * threshold;
   double sum = 0.0;
   double terms[kBetaGridRhoBins];

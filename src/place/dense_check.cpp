@@ -102,15 +102,14 @@ DenseReference::DenseReference(const std::vector<Eigen::Vector2i>& cells, double
 
 double DenseReference::EmptyBlockExit(const Eigen::Vector2d& origin_m,
                                       const Eigen::Vector2d& direction,
-                                      const Eigen::Vector2d& point_m, double s_m) const {
+                                      const Eigen::Vector2d& point_m, const Probe& probe,
+                                      double s_m) const {
   // Far beyond the rounding of any sample's position (about 1e-13 m within a few km), so that a
   // sample the exact geometry puts inside the block shrunk by this margin is computed inside it.
   constexpr double kBlockMarginM = 1e-6;
-  const double cell_i = std::floor(point_m.x() / cell_size_m_) - min_cell_.x() + margin_;
-  const double cell_j = std::floor(point_m.y() / cell_size_m_) - min_cell_.y() + margin_;
-  if (!(cell_i >= 0.0 && cell_j >= 0.0 && cell_i < width_ && cell_j < height_)) return s_m;
-  const int bi = static_cast<int>(cell_i) / kBlockCells;
-  const int bj = static_cast<int>(cell_j) / kBlockCells;
+  if (probe.raster_i < 0) return s_m;
+  const int bi = probe.raster_i / kBlockCells;
+  const int bj = probe.raster_j / kBlockCells;
   if (block_occupied_[static_cast<std::size_t>(bj) * blocks_wide_ + bi]) return s_m;
   const Eigen::Vector2d block_min = (Eigen::Vector2d(bi * kBlockCells, bj * kBlockCells) -
                                      Eigen::Vector2d(margin_, margin_) + min_cell_.cast<double>()) *
@@ -148,8 +147,11 @@ DenseReference::Probe DenseReference::ProbeAt(const Eigen::Vector2d& point_m) co
   const double i = cell_i - min_cell_.x() + margin_;
   const double j = cell_j - min_cell_.y() + margin_;
   if (i >= 0.0 && j >= 0.0 && i < width_ && j < height_) {
-    probe.flags = flags_[static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) +
-                         static_cast<std::size_t>(i)];
+    probe.raster_i = static_cast<int>(i);
+    probe.raster_j = static_cast<int>(j);
+    probe.flags =
+        flags_[static_cast<std::size_t>(probe.raster_j) * static_cast<std::size_t>(width_) +
+               static_cast<std::size_t>(probe.raster_i)];
   }
   return probe;
 }
@@ -196,7 +198,7 @@ bool DenseReference::SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::V
     crossed = true;
     if (!(probe.flags & kOccupied)) {
       // The samples before the empty block's exit are neither occupied nor needed for `crossed`.
-      const double exit = EmptyBlockExit(origin_m, direction, sample, s);
+      const double exit = EmptyBlockExit(origin_m, direction, sample, probe, s);
       if (exit > s) k = std::max(k, static_cast<std::int64_t>(std::ceil(exit / step)) - 1);
       continue;
     }

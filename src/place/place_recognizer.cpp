@@ -129,9 +129,9 @@ std::vector<DescriptorPair> MatchDescriptorPairs(const std::vector<BetaGridDescr
   std::vector<DescriptorPair> below;
   for (std::size_t c = 0; c < current.size(); ++c) {
     for (std::size_t r = 0; r < reference.size(); ++r) {
-      if (SymmetricChi2Below(current[c], reference[r], chi2_threshold)) {
-        below.push_back(
-            {static_cast<int>(c), static_cast<int>(r), SymmetricChi2(current[c], reference[r])});
+      const double distance = SymmetricChi2IfBelow(current[c], reference[r], chi2_threshold);
+      if (distance < chi2_threshold) {
+        below.push_back({static_cast<int>(c), static_cast<int>(r), distance});
       }
     }
   }

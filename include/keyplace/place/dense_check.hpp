@@ -107,20 +107,24 @@ class DenseReference {
   std::uint8_t FlagsAt(const Eigen::Vector2d& point_m) const;
   // Whether the point's cell lies in the box of the occupied cells and, only then, its flags
   // (FlagsAt; 0 outside the box, where FlagsAt may still see the margin): one cell computation
-  // for both (the beams' samples ask both, millions of times per query).
+  // for both (the beams' samples ask both, millions of times per query), kept for the block
+  // lookup of EmptyBlockExit.
   struct Probe {
     bool inside = false;
     std::uint8_t flags = 0;
+    int raster_i = -1;  // the point's raster cell (-1: none)
+    int raster_j = -1;
   };
   Probe ProbeAt(const Eigen::Vector2d& point_m) const;
   bool SeesThrough(const Eigen::Vector2d& origin_m, const Eigen::Vector2d& endpoint_m,
                    bool& crossed) const;
   // Where the beam from origin_m along direction (unit) leaves the block of kBlockCells² raster
-  // cells holding `point_m` (at parameter s_m), when that block holds no occupied cell: every
-  // sample before the returned parameter lies in the block, so none can be occupied. s_m itself
-  // when the block is occupied or the point lies within kBlockMarginM of its border.
+  // cells holding `point_m` (at parameter s_m; `probe` its ProbeAt), when that block holds no
+  // occupied cell: every sample before the returned parameter lies in the block, so none can be
+  // occupied. s_m itself when the block is occupied or the point lies within kBlockMarginM of
+  // its border.
   double EmptyBlockExit(const Eigen::Vector2d& origin_m, const Eigen::Vector2d& direction,
-                        const Eigen::Vector2d& point_m, double s_m) const;
+                        const Eigen::Vector2d& point_m, const Probe& probe, double s_m) const;
 
   double cell_size_m_ = 0.1;
   Eigen::Vector2i min_cell_ = Eigen::Vector2i::Zero();  // of the occupied cells
