@@ -40,6 +40,9 @@ void Validate(const LocalizerConfig& config) {
   if (!(config.query_every_m >= 0.0) || !std::isfinite(config.query_every_m)) {
     throw std::invalid_argument("LocalizerConfig.query_every_m must be finite and >= 0");
   }
+  if (!(config.search_near_m >= 0.0) || !std::isfinite(config.search_near_m)) {
+    throw std::invalid_argument("LocalizerConfig.search_near_m must be finite and >= 0");
+  }
   Validate(config.fix);
 }
 
@@ -157,7 +160,16 @@ void GlobalLocalizer::Reset() {
 
 LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
-  const PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
+  PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
+  if (config_.search_near_m > 0.0) {
+    const std::vector<Place>& places = recognizer_->places();
+    for (const Pose2& T_world_odom : beliefs_) {
+      const std::vector<int> near = PlaceIdsNear(
+          places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
+          config_.search_near_m, static_cast<std::size_t>(config_.place.retrieval_places));
+      query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
+    }
+  }
   std::vector<int> scan_ids = builder_.scan_ids();
   PlaceExclusion exclude;
   if (exclusion_) {

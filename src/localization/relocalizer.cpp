@@ -36,6 +36,7 @@ Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
   RememberForTrackCheck(scan, T_odom_robot, -1);
+  localizer_.set_beliefs(filter_.Beliefs());
   RelocalizationUpdate update =
       filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
   CheckTrack(T_odom_robot, update);
@@ -45,6 +46,7 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
   RememberForTrackCheck(scan, T_odom_robot, scan_id);
+  localizer_.set_beliefs(filter_.Beliefs());
   RelocalizationUpdate update = filter_.Update(
       localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id), T_odom_robot);
   CheckTrack(T_odom_robot, update);
@@ -93,6 +95,15 @@ void Relocalizer::CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& up
 }
 
 FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(policy_); }
+
+std::vector<Pose2> FixFilter::Beliefs() const {
+  std::vector<Pose2> beliefs;
+  if (status_ == FixStatus::kFixed) beliefs.push_back(T_world_odom_);
+  for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
+    for (const Hypothesis& hypothesis : *pool) beliefs.push_back(hypothesis.T_world_odom);
+  }
+  return beliefs;
+}
 
 void FixFilter::Reset() {
   status_ = FixStatus::kSearching;

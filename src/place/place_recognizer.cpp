@@ -61,6 +61,23 @@ MappedOverlap MapAndOverlap(const std::vector<Eigen::Vector2d>& reference_positi
 
 }  // namespace
 
+std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t candidates,
+                              const Eigen::Vector2d& position_m, double radius_m,
+                              std::size_t count) {
+  std::vector<std::pair<double, std::size_t>> near;  // (distance, index)
+  candidates = std::min(candidates, places.size());
+  for (std::size_t p = 0; p < candidates; ++p) {
+    const double distance_m = (places[p].T_world_place.translation() - position_m).norm();
+    if (distance_m <= radius_m) near.emplace_back(distance_m, p);
+  }
+  const std::size_t kept = std::min(count, near.size());
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(kept), near.end());
+  std::vector<int> ids;
+  ids.reserve(kept);
+  for (std::size_t k = 0; k < kept; ++k) ids.push_back(places[near[k].second].id);
+  return ids;
+}
+
 std::vector<Place> PlacesFromMap(const GlobalMap& map) {
   std::vector<Place> places;
   places.reserve(map.submaps.size());

@@ -138,7 +138,8 @@ std::unique_ptr<SqrtDescriptorIndex> IndexOfRetrieved(const std::vector<Place>& 
 
 Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorIndex* index,
                        const std::vector<std::size_t>& slots, const PlaceRecognitionConfig& config,
-                       const std::vector<BetaGridDescriptor>& query, std::size_t min_pairs,
+                       const std::vector<BetaGridDescriptor>& query,
+                       const std::vector<int>& also_search_ids, std::size_t min_pairs,
                        const PlaceExclusion& exclude, const PlaceWords* words) {
   Pairing pairing;
   pairing.by_place.resize(places.size());
@@ -156,8 +157,15 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
     searched[p] = 1;
   }
   if (words) {
+    const std::vector<char> eligible = searched;
     KeepRetrieved(*words, query, static_cast<std::size_t>(config.retrieval_places), searched);
-    for (std::size_t p = 0; p < places.size(); ++p) searched[p] = searched[p] && !too_small(p);
+    std::vector<int> also = also_search_ids;
+    std::sort(also.begin(), also.end());
+    for (std::size_t p = 0; p < places.size(); ++p) {
+      if (eligible[p] && std::binary_search(also.begin(), also.end(), places[p].id))
+        searched[p] = 1;
+      searched[p] = searched[p] && !too_small(p);
+    }
   }
   // The index finds, per place, the pairs below the threshold that the exhaustive loop of
   // MatchDescriptorPairs finds, in its order and with its distances.
@@ -630,7 +638,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   Pairing pairing;
   if (keypoints.positions.size() >= lowest_pairs) {
     pairing = PairWithPlaces(places_, index_.get(), slots_, config_, keypoints.descriptors,
-                             lowest_pairs, exclude, words_.get());
+                             query.also_search_ids, lowest_pairs, exclude, words_.get());
   }
   std::vector<int> rigid_star(places_.size(), -1);
   std::vector<std::vector<int>> orders(thresholds.size());

@@ -54,6 +54,9 @@ const ConfigFields<SlamConfig>& SlamConfigFields() {
              "a submap is not matched with its last N predecessors ...")
         .Double("exclude_recent_path_m", &C::exclude_recent_path_m, "m",
                 "... nor with submaps less than this path behind it")
+        .Double("loop_search_near_m", &C::loop_search_near_m, "m",
+                "retrieval words: loop queries also pair the submaps whose origin the estimate "
+                "puts this close to theirs (0 = words alone)")
         .Bool("all_scan_loop_queries", &C::all_scan_loop_queries,
               "loop queries with the keypoints of all the submap's scans, not its stable ones "
               "(when place.query_keypoints = all_scans)")

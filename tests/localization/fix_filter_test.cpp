@@ -1,5 +1,6 @@
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -52,6 +53,26 @@ TEST(FixFilter, OneAnswerIsNotAFixTwoThatAgreeAre) {
   EXPECT_NEAR(update.T_world_robot.x, expected.x, 1e-9);
   EXPECT_NEAR(update.T_world_robot.y, expected.y, 1e-9);
   EXPECT_FALSE(update.new_fix);
+}
+
+// What the Relocalizer tells its localizer to search near (LocalizerConfig::search_near_m): every
+// answer held while searching, then the fix and the answers challenging it.
+TEST(FixFilter, BeliefsAreTheAnswersHeldAndTheFix) {
+  FixFilter filter;
+  EXPECT_TRUE(filter.Beliefs().empty());
+  filter.Update(Answer(kWrong), Odometry(0));
+  filter.Update(Answer(kTrue), Odometry(8));
+  std::vector<Pose2> beliefs = filter.Beliefs();
+  ASSERT_EQ(beliefs.size(), 2u);
+  EXPECT_EQ(beliefs[0].x, kWrong.x);
+  EXPECT_EQ(beliefs[1].x, kTrue.x);
+  ASSERT_EQ(filter.Update(Answer(kTrue), Odometry(16)).status, FixStatus::kFixed);
+  beliefs = filter.Beliefs();
+  ASSERT_FALSE(beliefs.empty());
+  EXPECT_NEAR(beliefs.front().x, kTrue.x, 0.01);  // the fix comes first
+  EXPECT_NEAR(beliefs.front().y, kTrue.y, 0.01);
+  filter.Reset();
+  EXPECT_TRUE(filter.Beliefs().empty());
 }
 
 // Answers of one growing query (LocalizerConfig::query_every_m) share scans: a wrong pose they

@@ -242,6 +242,61 @@ TEST(Retrieval, GrownFromOnePlaceItAnswersAsWellAsOneBuiltAtOnce) {
       EvaluateQueries(queries, PlaceRecognizer(places, config), SelfMatchRule::kSameScans), 0.8);
 }
 
+// Places the caller names are paired whatever their words rank: naming every place (and an id
+// the map does not hold) while retrieving one gives the exact path's answers field for field,
+// excluded places staying excluded (the self-match rule would otherwise answer with the query's
+// own submap).
+TEST(Retrieval, PlacesAlsoSearchedArePairedAsByTheExactPath) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
+  const std::vector<LocalizationRecord> exact =
+      EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
+  ASSERT_GT(CountAnswers(exact).correct, static_cast<int>(queries.size()) / 2);
+  for (LocalizationQuery& query : queries) {
+    query.query.also_search_ids.push_back(-7);
+    for (const Place& place : places) query.query.also_search_ids.push_back(place.id);
+  }
+  ExpectSameAnswers(
+      EvaluateQueries(queries, PlaceRecognizer(places, WordsConfig(1)), SelfMatchRule::kSameScans),
+      exact);
+}
+
+// What SLAM's loop queries name (SlamConfig::loop_search_near_m): the places whose origin lies
+// near where the query is believed to be. With one place retrieved by words, naming those within
+// 3 m of the query's true pose brings back most of the exact path's right answers.
+TEST(Retrieval, PlacesNearTheQueryAlsoSearchedBringBackItsAnswers) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(5);
+  const PlaceRecognizer words(places, WordsConfig(1));
+  const std::vector<LocalizationRecord> alone =
+      EvaluateQueries(queries, words, SelfMatchRule::kSameScans);
+  for (LocalizationQuery& query : queries) {
+    query.query.also_search_ids =
+        PlaceIdsNear(places, places.size(), query.truth.translation(), 3.0, 50);
+  }
+  const std::vector<LocalizationRecord> near =
+      EvaluateQueries(queries, words, SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> exact =
+      EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
+  EXPECT_GT(CountAnswers(near).correct, CountAnswers(alone).correct + 10);
+  ExpectNearlyAsManyRightAnswers(near, exact, 0.9);
+}
+
+TEST(PlaceIdsNear, NearestFirstWithinTheRadiusAmongTheCandidates) {
+  std::vector<Place> places(5);
+  const double x_m[] = {4.0, 1.0, 3.0, 0.5, 1.0};
+  for (std::size_t p = 0; p < places.size(); ++p) {
+    places[p].id = 10 + static_cast<int>(p);
+    places[p].T_world_place = Pose2(x_m[p], 2.0, 0.3);
+  }
+  const Eigen::Vector2d here(0.0, 2.0);
+  EXPECT_EQ(PlaceIdsNear(places, 5, here, 3.0, 10), (std::vector<int>{13, 11, 14, 12}));
+  EXPECT_EQ(PlaceIdsNear(places, 5, here, 3.0, 2), (std::vector<int>{13, 11}));   // ties: map order
+  EXPECT_EQ(PlaceIdsNear(places, 3, here, 3.0, 10), (std::vector<int>{11, 12}));  // first three
+  EXPECT_EQ(PlaceIdsNear(places, 9, here, 0.9, 10), (std::vector<int>{13}));
+  EXPECT_TRUE(PlaceIdsNear(places, 5, here, 0.1, 10).empty());
+}
+
 TEST(Retrieval, PlacesMustBePositive) {
   PlaceRecognitionConfig config = WordsConfig(0);
   try {

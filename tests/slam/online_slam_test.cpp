@@ -262,6 +262,33 @@ TEST(OnlineSlam, ScanInEntryExtractsTheKeypointsOfTheOdometryFrame) {
   }
 }
 
+// Loop queries retrieve places by their words (place.retrieval auto); with one place retrieved the
+// words alone miss loops here, and the submaps the estimate puts within loop_search_near_m of the
+// query's origin, paired besides, bring them back (all of them: every place retrieved finds 10).
+TEST(OnlineSlam, LoopQueriesAlsoPairTheSubmapsTheEstimatePutsNearby) {
+  const SimulatedRun run = Simulate(1.4);
+  const FlirtExtractor extractor;
+  std::vector<std::vector<Keypoint>> keypoints;
+  keypoints.reserve(run.scans.size());
+  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  const auto loops_found = [&](int retrieval_places, double loop_search_near_m) {
+    SlamConfig config = SimulationConfig();
+    config.place.retrieval_places = retrieval_places;
+    config.loop_search_near_m = loop_search_near_m;
+    OnlineSlam slam(config);
+    for (std::size_t i = 0; i < run.scans.size(); ++i) {
+      slam.AddScan(static_cast<int>(i), run.scans[i], run.scans[i].odometry_pose, keypoints[i]);
+    }
+    slam.Finish();
+    return slam.loops().size();
+  };
+  const std::size_t words_alone = loops_found(1, 0.0);
+  const std::size_t with_nearby = loops_found(1, 3.0);
+  // Measured: 3 loops with the words alone, 10 with the submaps nearby (as with every place
+  // retrieved).
+  EXPECT_GE(with_nearby, words_alone + 5) << "words alone " << words_alone;
+}
+
 TEST(OnlineSlam, RejectsInvalidConfig) {
   SlamConfig config;
   config.optimize_every_loops = 0;
@@ -271,6 +298,9 @@ TEST(OnlineSlam, RejectsInvalidConfig) {
   EXPECT_THROW(Validate(config), std::invalid_argument);
   config = SlamConfig();
   config.defer_loop_residual_sigmas = -1.0;
+  EXPECT_THROW(Validate(config), std::invalid_argument);
+  config = SlamConfig();
+  config.loop_search_near_m = -1.0;
   EXPECT_THROW(Validate(config), std::invalid_argument);
 }
 

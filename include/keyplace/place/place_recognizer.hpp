@@ -38,6 +38,13 @@ struct Place {
 /// One place per submap, in map order (keypoints in the submap frame, T_world_place = P[0]).
 std::vector<Place> PlacesFromMap(const GlobalMap& map);
 
+/// Ids of the first `candidates` places whose origin lies within `radius_m` of `position_m`, at
+/// most `count` of them, nearest first (ties: map order): PlaceQuery::also_search_ids for a
+/// query the caller already places near position_m.
+std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t candidates,
+                              const Eigen::Vector2d& position_m, double radius_m,
+                              std::size_t count);
+
 /// The keypoints of the current submap S_c in its own frame (P_c[0]) and p_c: the pose to
 /// estimate, relative to P_c[0] (its last scan in the paper).
 struct PlaceQuery {
@@ -51,6 +58,10 @@ struct PlaceQuery {
   // Optional: the latest scans' beams in the same frame, for the dense check
   // (PlaceRecognitionConfig::dense_min_hit_fraction). Empty: keypoints alone decide.
   std::vector<QueryScanPoints> scans;
+  // Optional, with retrieval `words`: ids of places paired whatever their words rank (those near
+  // where the caller already believes the query lies: SLAM's estimate). `exact` pairs every place
+  // anyway; an id the map does not hold, or an excluded place, is not searched.
+  std::vector<int> also_search_ids;
 };
 
 /// Greedy merge: keeps each keypoint unless one already kept lies within `radius_m` (input order

@@ -45,6 +45,11 @@ struct SlamConfig {
   // are neighbours that overlap by construction, not loops.
   int exclude_recent_submaps = 10;
   double exclude_recent_path_m = 10.0;
+  // With retrieval `words` (place.retrieval auto), a loop query also pairs the eligible submaps
+  // whose estimated origin lies within this of its own (at most place.retrieval_places, nearest
+  // first), whatever their words rank: a loop the estimate already expects is not left to the
+  // words (docs/SLAM.md, "Retrieval in loop queries"). 0: the words alone.
+  double loop_search_near_m = 3.0;
   // Query each completed submap with the keypoints of all its scans, as `keyplace localize`
   // does, instead of its ~18 stable keypoints (issue 17: a building whose stable keypoints do not
   // recur got no loop). Applies when place.query_keypoints = all_scans (the default presets; the
