@@ -161,7 +161,10 @@ void GlobalLocalizer::Reset() {
 LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
   PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
-  if (config_.search_near_m > 0.0) {
+  // The words may leave out the place that would confirm a belief (exact pairs every place):
+  // from the latest scan, where the robot is, as a query may span 300 scans.
+  if (config_.search_near_m > 0.0 &&
+      config_.place.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
     const std::vector<Place>& places = recognizer_->places();
     for (const Pose2& T_world_odom : beliefs_) {
       const std::vector<int> near = PlaceIdsNear(

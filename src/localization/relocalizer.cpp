@@ -99,8 +99,13 @@ FixFilter::FixFilter(const FixPolicy& policy) : policy_(policy) { Validate(polic
 std::vector<Pose2> FixFilter::Beliefs() const {
   std::vector<Pose2> beliefs;
   if (status_ == FixStatus::kFixed) beliefs.push_back(T_world_odom_);
+  // The pools are pruned when an answer comes; one older than the window is already forgotten.
   for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
-    for (const Hypothesis& hypothesis : *pool) beliefs.push_back(hypothesis.T_world_odom);
+    for (const Hypothesis& hypothesis : *pool) {
+      if (odometry_m_ - hypothesis.odometry_m <= policy_.window_m) {
+        beliefs.push_back(hypothesis.T_world_odom);
+      }
+    }
   }
   return beliefs;
 }

@@ -22,7 +22,9 @@ void Validate(const SlamConfig& config) {
   };
   if (config.exclude_recent_submaps < 0) fail("exclude_recent_submaps", "must be >= 0");
   if (!(config.exclude_recent_path_m >= 0.0)) fail("exclude_recent_path_m", "must be >= 0");
-  if (!(config.loop_search_near_m >= 0.0)) fail("loop_search_near_m", "must be >= 0");
+  if (!(config.loop_search_near_m >= 0.0) || !std::isfinite(config.loop_search_near_m)) {
+    fail("loop_search_near_m", "must be finite and >= 0");
+  }
   if (!(config.gate_base_m >= 0.0)) fail("gate_base_m", "must be >= 0");
   if (!(config.gate_per_path >= 0.0)) fail("gate_per_path", "must be >= 0");
   if (!(config.gate_base_rad >= 0.0)) fail("gate_base_rad", "must be >= 0");
@@ -233,7 +235,8 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
       for (std::size_t i = held; i < eligible; ++i) recognizer_->AddPlace(places_[i]);
     }
     ++stats_.queries;
-    if (config_.loop_search_near_m > 0.0) {
+    if (config_.loop_search_near_m > 0.0 &&
+        config_.place.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
       query.also_search_ids = PlaceIdsNear(
           places_, eligible, places_.back().T_world_place.translation(), config_.loop_search_near_m,
           static_cast<std::size_t>(config_.place.retrieval_places));

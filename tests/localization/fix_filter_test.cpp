@@ -73,6 +73,12 @@ TEST(FixFilter, BeliefsAreTheAnswersHeldAndTheFix) {
   EXPECT_NEAR(beliefs.front().y, kTrue.y, 0.01);
   filter.Reset();
   EXPECT_TRUE(filter.Beliefs().empty());
+  // An answer older than the window (20 m of odometry) is forgotten before the next one comes.
+  filter.Update(Answer(kTrue), Odometry(0));
+  filter.Update(std::nullopt, Odometry(80));  // 20 m on: still within
+  EXPECT_EQ(filter.Beliefs().size(), 1u);
+  filter.Update(std::nullopt, Odometry(81));
+  EXPECT_TRUE(filter.Beliefs().empty());
 }
 
 // Answers of one growing query (LocalizerConfig::query_every_m) share scans: a wrong pose they

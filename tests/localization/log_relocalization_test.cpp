@@ -97,6 +97,27 @@ TEST(RelocalizeLog, FixesTheSecondHalfWithoutTruthAndKeepsEveryScansStatus) {
   EXPECT_LE(run.update_seconds_mean, run.update_seconds_max);
 }
 
+// With retrieval `words` and one place retrieved, the words alone rarely bring the place that
+// would confirm an answer; the Relocalizer hands its answers to the localizer as beliefs
+// (LocalizerConfig::search_near_m), whose queries then also pair the places near them.
+TEST(RelocalizeLog, AnswersHeldMakeTheQueriesAlsoPairThePlacesTheyPointTo) {
+  const GlobalMap map = FirstHalfMap();
+  const LogInputs inputs = SecondHalfWithoutTruth();
+  const auto fixed_scans = [&](double search_near_m) {
+    LocalizerConfig config = ToLocalizerConfig(PresetConfig("strict"));
+    config.place.retrieval = PlaceRecognitionConfig::Retrieval::kWords;
+    config.place.retrieval_places = 1;
+    config.search_near_m = search_near_m;
+    const LogRelocalization run = RelocalizeLog(map, inputs, config, nullptr);
+    std::size_t fixed = 0;
+    for (const RelocalizedScan& scan : run.scans) fixed += scan.status == FixStatus::kFixed;
+    return fixed;
+  };
+  const std::size_t words_alone = fixed_scans(0.0);
+  // Measured: 512 scans fixed with the words alone, 538 with the places near the answers.
+  EXPECT_GT(fixed_scans(3.0), words_alone + 10) << "words alone " << words_alone;
+}
+
 TEST(RelocalizeLog, InputsWithoutAPosePerScanAreRefusedNamingTheLog) {
   LogInputs inputs = SecondHalfWithoutTruth();
   inputs.poses.pop_back();

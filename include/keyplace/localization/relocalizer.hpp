@@ -97,7 +97,8 @@ class FixFilter {
   FixStatus status() const { return status_; }
 
   /// Where the answers held put the odometry frame in the map (map <- odometry): the fix's while
-  /// fixed, and every pending or challenging answer's, in the order held.
+  /// fixed, and every pending or challenging answer's not older than window_m, in the order
+  /// held.
   std::vector<Pose2> Beliefs() const;
 
   /// Gives the fix up, as an answer contradicting it would (update: the one of this scan, which

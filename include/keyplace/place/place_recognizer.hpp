@@ -59,8 +59,9 @@ struct PlaceQuery {
   // (PlaceRecognitionConfig::dense_min_hit_fraction). Empty: keypoints alone decide.
   std::vector<QueryScanPoints> scans;
   // Optional, with retrieval `words`: ids of places paired whatever their words rank (those near
-  // where the caller already believes the query lies: SLAM's estimate). `exact` pairs every place
-  // anyway; an id the map does not hold, or an excluded place, is not searched.
+  // where the caller already believes the query lies: SLAM's estimate, the Relocalizer's answers
+  // and fix). `exact` pairs every place anyway; an id the map does not hold, or an excluded place,
+  // is not searched.
   std::vector<int> also_search_ids;
 };
 
