@@ -36,6 +36,15 @@ double AlignedMaxError(const std::vector<Pose2>& estimate, const std::vector<Pos
   return worst;
 }
 
+// FLIRT keypoints of every scan of a run (extracted once per test, shared by its SLAM runs).
+std::vector<std::vector<Keypoint>> KeypointsOf(const SimulatedRun& run) {
+  const FlirtExtractor extractor;
+  std::vector<std::vector<Keypoint>> keypoints;
+  keypoints.reserve(run.scans.size());
+  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  return keypoints;
+}
+
 TEST(OnlineSlam, ClosesTheSquareLoopAndRemovesTheDrift) {
   const SimulatedRun run = Simulate(1.4);
   const FlirtExtractor extractor;
@@ -142,10 +151,7 @@ TEST(OnlineSlam, LoopsTheEstimateAlreadyMeetsWaitForTheNextOptimisation) {
 // held to place.min_gamma_all_scans instead.
 TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
   const SimulatedRun run = Simulate(1.4);
-  const FlirtExtractor extractor;
-  std::vector<std::vector<Keypoint>> keypoints;
-  keypoints.reserve(run.scans.size());
-  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  const std::vector<std::vector<Keypoint>> keypoints = KeypointsOf(run);
   std::size_t rejected_by_point_overlap = 0;
   auto loops_found = [&](bool all_scan_loop_queries, double min_gamma_all_scans,
                          PlaceRecognitionConfig::QueryKeypoints query_keypoints =
@@ -186,10 +192,7 @@ TEST(OnlineSlam, LoopQueriesUseTheKeypointsOfAllScans) {
 // 4 cm, 0 / 0 at 6 cm): a change to FLIRT or to the place thresholds may move them.
 TEST(OnlineSlam, AllScanLoopQueriesFindTheLoopsStableOnesMissInANoisyWorld) {
   const SimulatedRun run = Simulate(1.4, 0.04);
-  const FlirtExtractor extractor;
-  std::vector<std::vector<Keypoint>> keypoints;
-  keypoints.reserve(run.scans.size());
-  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  const std::vector<std::vector<Keypoint>> keypoints = KeypointsOf(run);
   auto run_slam = [&](bool all_scan_loop_queries) {
     SlamConfig config = SimulationConfig();
     config.all_scan_loop_queries = all_scan_loop_queries;
@@ -267,10 +270,7 @@ TEST(OnlineSlam, ScanInEntryExtractsTheKeypointsOfTheOdometryFrame) {
 // query's origin, paired besides, bring them back (all of them: every place retrieved finds 10).
 TEST(OnlineSlam, LoopQueriesAlsoPairTheSubmapsTheEstimatePutsNearby) {
   const SimulatedRun run = Simulate(1.4);
-  const FlirtExtractor extractor;
-  std::vector<std::vector<Keypoint>> keypoints;
-  keypoints.reserve(run.scans.size());
-  for (const LogScan& scan : run.scans) keypoints.push_back(extractor.Extract(scan));
+  const std::vector<std::vector<Keypoint>> keypoints = KeypointsOf(run);
   const auto loops_found = [&](int retrieval_places, double loop_search_near_m) {
     SlamConfig config = SimulationConfig();
     config.place.retrieval_places = retrieval_places;
