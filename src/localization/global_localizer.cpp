@@ -161,17 +161,14 @@ void GlobalLocalizer::Reset() {
 LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
   PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
-  // The words may leave out the place that would confirm a belief (exact pairs every place):
-  // from the latest scan, where the robot is, as a query may span 300 scans.
-  if (config_.search_near_m > 0.0 &&
-      config_.place.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
-    const std::vector<Place>& places = recognizer_->places();
-    for (const Pose2& T_world_odom : beliefs_) {
-      const std::vector<int> near = PlaceIdsNear(
-          places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
-          config_.search_near_m, static_cast<std::size_t>(config_.place.retrieval_places));
-      query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
-    }
+  // The words may leave out the place that would confirm a belief. Searched around the latest
+  // scan, where the robot is, as a query may span 300 scans.
+  const std::vector<Place>& places = recognizer_->places();
+  for (const Pose2& T_world_odom : beliefs_) {
+    const std::vector<int> near = PlaceIdsToAlsoSearch(
+        config_.place, places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
+        config_.search_near_m);
+    query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
   }
   std::vector<int> scan_ids = builder_.scan_ids();
   PlaceExclusion exclude;

@@ -102,9 +102,7 @@ std::vector<Pose2> FixFilter::Beliefs() const {
   // The pools are pruned when an answer comes; one older than the window is already forgotten.
   for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
     for (const Hypothesis& hypothesis : *pool) {
-      if (odometry_m_ - hypothesis.odometry_m <= policy_.window_m) {
-        beliefs.push_back(hypothesis.T_world_odom);
-      }
+      if (!Forgotten(hypothesis)) beliefs.push_back(hypothesis.T_world_odom);
     }
   }
   return beliefs;
@@ -369,11 +367,13 @@ bool FixFilter::OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_
   return !contradicted;
 }
 
+bool FixFilter::Forgotten(const Hypothesis& hypothesis) const {
+  return odometry_m_ - hypothesis.odometry_m > policy_.window_m;
+}
+
 void FixFilter::Forget(std::vector<Hypothesis>& pool) const {
   pool.erase(std::remove_if(pool.begin(), pool.end(),
-                            [&](const Hypothesis& h) {
-                              return odometry_m_ - h.odometry_m > policy_.window_m;
-                            }),
+                            [this](const Hypothesis& h) { return Forgotten(h); }),
              pool.end());
 }
 

@@ -78,6 +78,16 @@ std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t cand
   return ids;
 }
 
+std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config,
+                                      const std::vector<Place>& places, std::size_t candidates,
+                                      const Eigen::Vector2d& position_m, double radius_m) {
+  if (config.retrieval != PlaceRecognitionConfig::Retrieval::kWords || !(radius_m > 0.0)) {
+    return {};
+  }
+  return PlaceIdsNear(places, candidates, position_m, radius_m,
+                      static_cast<std::size_t>(config.retrieval_places));
+}
+
 std::vector<Place> PlacesFromMap(const GlobalMap& map) {
   std::vector<Place> places;
   places.reserve(map.submaps.size());

@@ -235,12 +235,9 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
       for (std::size_t i = held; i < eligible; ++i) recognizer_->AddPlace(places_[i]);
     }
     ++stats_.queries;
-    if (config_.loop_search_near_m > 0.0 &&
-        config_.place.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
-      query.also_search_ids = PlaceIdsNear(
-          places_, eligible, places_.back().T_world_place.translation(), config_.loop_search_near_m,
-          static_cast<std::size_t>(config_.place.retrieval_places));
-    }
+    query.also_search_ids = PlaceIdsToAlsoSearch(config_.place, places_, eligible,
+                                                 places_.back().T_world_place.translation(),
+                                                 config_.loop_search_near_m);
     step.match = recognizer_->Recognize(query);
     if (step.match.found) {
       LoopClosure loop;

@@ -134,7 +134,8 @@ class FixFilter {
   // from another query (answers of one query share its scans: their agreement proves nothing).
   std::vector<Hypothesis> Agreeing(const std::vector<Hypothesis>& pool,
                                    const Hypothesis& hypothesis, const Pose2& T_odom_robot) const;
-  void Forget(std::vector<Hypothesis>& pool) const;  // drops those older than window_m
+  void Forget(std::vector<Hypothesis>& pool) const;    // drops the Forgotten ones
+  bool Forgotten(const Hypothesis& hypothesis) const;  // older than window_m
   void Confirm(const Hypothesis& answer, const Pose2& T_odom_robot);
   void DeclareFix(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest,
                   RelocalizationUpdate& update);

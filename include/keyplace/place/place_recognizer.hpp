@@ -45,6 +45,13 @@ std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t cand
                               const Eigen::Vector2d& position_m, double radius_m,
                               std::size_t count);
 
+/// What a query under `config` names near position_m (PlaceQuery::also_search_ids): PlaceIdsNear
+/// within radius_m, at most config.retrieval_places; none unless retrieval is `words` (`exact`
+/// pairs every place anyway) and radius_m > 0.
+std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config,
+                                      const std::vector<Place>& places, std::size_t candidates,
+                                      const Eigen::Vector2d& position_m, double radius_m);
+
 /// The keypoints of the current submap S_c in its own frame (P_c[0]) and p_c: the pose to
 /// estimate, relative to P_c[0] (its last scan in the paper).
 struct PlaceQuery {
