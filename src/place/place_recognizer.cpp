@@ -111,9 +111,12 @@ std::vector<DescriptorPair> UniquePairs(std::vector<DescriptorPair> below, std::
                                         std::size_t n_reference,
                                         PlaceRecognitionConfig::PairMatching mode) {
   if (mode == PlaceRecognitionConfig::PairMatching::kGlobalGreedy) {
-    std::stable_sort(
-        below.begin(), below.end(),
-        [](const DescriptorPair& a, const DescriptorPair& b) { return a.distance < b.distance; });
+    // By distance, equal ones in their given (current, reference) order: what a stable sort by
+    // distance gives, without its buffer (it was a twentieth of SLAM's main thread on Intel_r).
+    std::sort(below.begin(), below.end(), [](const DescriptorPair& a, const DescriptorPair& b) {
+      if (a.distance != b.distance) return a.distance < b.distance;
+      return a.current != b.current ? a.current < b.current : a.reference < b.reference;
+    });
   }
   // kQueryOrder: `below` is ordered by current keypoint; each takes its nearest unused reference.
   std::vector<char> current_used(n_current, 0);

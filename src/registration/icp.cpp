@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -260,6 +261,58 @@ bool IcpTarget::Nearest(const Eigen::Vector2d& query, std::size_t* index,
   return true;
 }
 
+namespace {
+
+// nanoflann's result set for one neighbour that starts with a bound (and perhaps a candidate):
+// the tree search skips every branch farther than the best so far, so a good start prunes it.
+class BoundedNearest {
+ public:
+  BoundedNearest(double bound_d2, std::size_t candidate, bool has_candidate)
+      : best_d2_(bound_d2), best_index_(candidate), found_(has_candidate) {}
+  bool addPoint(double d2, std::size_t index) {
+    if (d2 < best_d2_) {  // the tree passes only points below worstDist(); kept for clarity
+      best_d2_ = d2;
+      best_index_ = index;
+      found_ = true;
+    }
+    return true;
+  }
+  double worstDist() const { return best_d2_; }
+  bool full() const { return found_; }
+  std::size_t best_index() const { return best_index_; }
+
+ private:
+  double best_d2_;
+  std::size_t best_index_;
+  bool found_;
+};
+
+}  // namespace
+
+bool IcpTarget::NearestWithin(const Eigen::Vector2d& query, double max_squared_distance_m2,
+                              std::size_t hint, std::size_t* index,
+                              double* squared_distance_m2) const {
+  const std::vector<Eigen::Vector2d>& points = impl_->points;
+  if (points.empty() || !(max_squared_distance_m2 >= 0.0)) return false;
+  // The tree keeps only points strictly below the bound; a point at the bound itself counts.
+  double bound_d2 =
+      std::nextafter(max_squared_distance_m2, std::numeric_limits<double>::infinity());
+  bool has_candidate = false;
+  if (hint < points.size()) {
+    const double hint_d2 = (points[hint] - query).squaredNorm();
+    if (hint_d2 <= max_squared_distance_m2) {
+      bound_d2 = hint_d2;
+      has_candidate = true;
+    }
+  }
+  BoundedNearest result(bound_d2, hint, has_candidate);
+  impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (!result.full()) return false;
+  if (index != nullptr) *index = result.best_index();
+  if (squared_distance_m2 != nullptr) *squared_distance_m2 = result.worstDist();
+  return true;
+}
+
 // ------------------------------------------------------------------------------------------
 // Alignment
 
@@ -314,13 +367,16 @@ IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vec
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     int count = 0;
+    std::size_t index =
+        IcpTarget::kNoHint;  // the previous point's neighbour: the next one's is near it
     for (const Eigen::Vector2d& p : source) {
       // Source point relative to the sensor origin, rotated into the target frame.
       const Eigen::Vector2d rp(c * p.x() - s * p.y(), s * p.x() + c * p.y());
       const Eigen::Vector2d pt(rp.x() + x, rp.y() + y);
-      std::size_t index = 0;
       double d2 = 0.0;
-      if (!target.Nearest(pt, &index, &d2) || d2 > gate_d2 || !target.HasNormal(index)) continue;
+      if (!target.NearestWithin(pt, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
+        continue;
+      }
       const Eigen::Vector2d& n = target.normal(index);
       const double r = n.dot(pt - target.points()[index]);
       // d r / d(dx, dy, dtheta), rotation about the current sensor origin.
@@ -398,11 +454,14 @@ IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vec
   // Final statistics at the estimate.
   int inliers = 0;
   double sum_r2 = 0.0;
+  std::size_t index = IcpTarget::kNoHint;
+  const PointMapper to_target(estimate);
   for (const Eigen::Vector2d& p : source) {
-    const Eigen::Vector2d pt = estimate * p;
-    std::size_t index = 0;
+    const Eigen::Vector2d pt = to_target(p);
     double d2 = 0.0;
-    if (!target.Nearest(pt, &index, &d2) || d2 > gate_d2 || !target.HasNormal(index)) continue;
+    if (!target.NearestWithin(pt, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
+      continue;
+    }
     const double r = target.normal(index).dot(pt - target.points()[index]);
     if (std::abs(r) > config.inlier_distance_m) continue;
     ++inliers;

@@ -164,7 +164,8 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
   const Eigen::Matrix2d R = Eigen::Rotation2Dd(T_world_laser.theta).toRotationMatrix();
   for (Eigen::Vector2d& n : keyframe.normals_world.normals) n = R * n;
   keyframe.points_world.reserve(points_laser.size());
-  for (const Eigen::Vector2d& p : points_laser) keyframe.points_world.push_back(T_world_laser * p);
+  const PointMapper to_world(T_world_laser);
+  for (const Eigen::Vector2d& p : points_laser) keyframe.points_world.push_back(to_world(p));
   keyframes_.push_back(std::move(keyframe));
   while (static_cast<int>(keyframes_.size()) > config_.local_map_scans) keyframes_.pop_front();
 

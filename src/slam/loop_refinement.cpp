@@ -22,11 +22,14 @@ int CountInliers(const IcpTarget& target, const std::vector<Eigen::Vector2d>& so
                  const Pose2& T_target_source, const IcpConfig& icp) {
   const double gate_d2 = icp.max_correspondence_distance_m * icp.max_correspondence_distance_m;
   int inliers = 0;
+  std::size_t index = IcpTarget::kNoHint;  // the previous point's neighbour: the next one's is near
+  const PointMapper to_target(T_target_source);
   for (const Eigen::Vector2d& p : source) {
-    const Eigen::Vector2d q = T_target_source * p;
-    std::size_t index = 0;
+    const Eigen::Vector2d q = to_target(p);
     double d2 = 0.0;
-    if (!target.Nearest(q, &index, &d2) || d2 > gate_d2 || !target.HasNormal(index)) continue;
+    if (!target.NearestWithin(q, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
+      continue;
+    }
     if (std::abs(target.normal(index).dot(q - target.points()[index])) <= icp.inlier_distance_m) {
       ++inliers;
     }
@@ -116,14 +119,17 @@ double PointOverlap(const SubmapCloud& a, const SubmapCloud& b, const Pose2& T_a
   return Overlap(target_a, a, target_b, b, T_a_b, icp);
 }
 
-LoopRefinement RefineLoop(const SubmapCloud& reference, const SubmapCloud& current,
-                          const Pose2& T_ref_cur_initial, const LoopRefinementConfig& config) {
-  Validate(config);
+namespace {
+
+// RefineLoop with the current submap's target built by the caller, who refines one current
+// submap against several references (ChooseLoopPartner) and builds it once.
+LoopRefinement RefineLoopAgainst(const SubmapCloud& reference, const SubmapCloud& current,
+                                 const IcpTarget& target_cur, const Pose2& T_ref_cur_initial,
+                                 const LoopRefinementConfig& config) {
   LoopRefinement result;
   result.T_ref_cur = T_ref_cur_initial;
   if (reference.points.empty() || current.points.empty()) return result;
   const IcpTarget target_ref(reference.points, reference.normals, config.icp);
-  const IcpTarget target_cur(current.points, current.normals, config.icp);
   const double n_cur = static_cast<double>(current.points.size());
   result.inlier_ratio_initial =
       CountInliers(target_ref, current.points, T_ref_cur_initial, config.icp) / n_cur;
@@ -149,21 +155,33 @@ LoopRefinement RefineLoop(const SubmapCloud& reference, const SubmapCloud& curre
   return result;
 }
 
+}  // namespace
+
+LoopRefinement RefineLoop(const SubmapCloud& reference, const SubmapCloud& current,
+                          const Pose2& T_ref_cur_initial, const LoopRefinementConfig& config) {
+  Validate(config);
+  const IcpTarget target_cur(current.points, current.normals, config.icp);
+  return RefineLoopAgainst(reference, current, target_cur, T_ref_cur_initial, config);
+}
+
 LoopPartnerChoice ChooseLoopPartner(const SubmapCloud& current, int matched_id,
                                     const SubmapCloud& matched, const Pose2& T_matched_cur_initial,
                                     const std::vector<LoopPartnerCandidate>& candidates,
                                     const LoopRefinementConfig& config) {
+  Validate(config);
+  const IcpTarget target_cur(current.points, current.normals, config.icp);
   LoopPartnerChoice choice;
   choice.partner = matched_id;
-  choice.refinement = RefineLoop(matched, current, T_matched_cur_initial, config);
+  choice.refinement =
+      RefineLoopAgainst(matched, current, target_cur, T_matched_cur_initial, config);
   const Pose2 T_matched_cur = choice.refinement.T_ref_cur;
   for (const LoopPartnerCandidate& candidate : candidates) {
     if (candidate.cloud == nullptr) {
       throw std::invalid_argument("ChooseLoopPartner: candidate " + std::to_string(candidate.id) +
                                   " has no cloud");
     }
-    LoopRefinement r = RefineLoop(*candidate.cloud, current,
-                                  candidate.T_candidate_matched * T_matched_cur, config);
+    LoopRefinement r = RefineLoopAgainst(*candidate.cloud, current, target_cur,
+                                         candidate.T_candidate_matched * T_matched_cur, config);
     if (r.overlap > choice.refinement.overlap) {
       choice.partner = candidate.id;
       choice.refinement = r;

@@ -370,6 +370,30 @@ TEST(DescriptorPairs, EachKeypointUsedOnce) {
   EXPECT_DOUBLE_EQ(greedy[0].distance, 0.0);
 }
 
+// Global greedy takes the pairs by distance and equally distant ones in (current, reference)
+// order, as Algorithm 3's loop meets them: with hundreds of ties any other order (an unstable
+// sort by distance alone) pairs the keypoints differently.
+TEST(DescriptorPairs, GlobalGreedyBreaksTiesInQueryThenReferenceOrder) {
+  const BetaGridDescriptor a = Descriptor(1);
+  BetaGridDescriptor a2 = a;
+  a2[3] += 0.05f;
+  std::vector<BetaGridDescriptor> current;
+  for (int c = 0; c < 30; ++c) current.push_back(c % 2 == 0 ? a : a2);
+  const std::vector<BetaGridDescriptor> reference(20, a);
+  const auto greedy = MatchDescriptorPairs(current, reference, 0.4,
+                                           PlaceRecognitionConfig::PairMatching::kGlobalGreedy);
+  std::vector<std::pair<int, int>> expected;
+  for (int c = 0; c < 30; c += 2) expected.emplace_back(c, c / 2);  // distance 0 first
+  for (int c = 1; c < 10; c += 2) expected.emplace_back(c, 15 + c / 2);
+  ASSERT_EQ(greedy.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(greedy[k].current, expected[k].first) << k;
+    EXPECT_EQ(greedy[k].reference, expected[k].second) << k;
+  }
+  EXPECT_EQ(greedy[0].distance, 0.0);
+  EXPECT_GT(greedy.back().distance, 0.0);
+}
+
 TEST(PlaceConfig, KeyValuesRoundTripAndErrorsNameTheField) {
   PlaceRecognitionConfig config = PaperPlaceConfig();
   std::map<std::string, std::string> values;

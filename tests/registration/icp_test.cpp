@@ -281,6 +281,65 @@ TEST(IcpTest, KdTreeNearestMatchesBruteForce) {
   }
 }
 
+// The bounded search with a hint finds what a scan of every point finds: the nearest point when
+// it lies within the bound (the bound itself included), nothing otherwise, whether the hint is
+// the previous answer, a far point, a point beyond the bound or no point at all.
+TEST(IcpTest, NearestWithinMatchesBruteForceWhateverTheHint) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::vector<Eigen::Vector2d> points(2000);
+  for (auto& p : points) p = {u(rng), u(rng)};
+  const IcpTarget target(points, IcpConfig{});
+  const double bound_d2 = 0.04;
+  std::size_t previous = IcpTarget::kNoHint;
+  int within = 0;
+  int beyond = 0;
+  for (int q = 0; q < 2000; ++q) {
+    const Eigen::Vector2d query(u(rng) * 1.2, u(rng) * 1.2);
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
+    const std::size_t far_point = static_cast<std::size_t>(q) % points.size();
+    for (const std::size_t hint : {previous, far_point, IcpTarget::kNoHint, points.size() + 3}) {
+      std::size_t index = 0;
+      double d2 = -1.0;
+      const bool found = target.NearestWithin(query, bound_d2, hint, &index, &d2);
+      ASSERT_EQ(found, best <= bound_d2) << "query " << q << ", hint " << hint;
+      if (!found) continue;
+      EXPECT_EQ(d2, best);
+      EXPECT_EQ((points[index] - query).squaredNorm(), best);
+    }
+    if (best <= bound_d2) {
+      ++within;
+    } else {
+      ++beyond;
+    }
+    target.NearestWithin(query, bound_d2, previous, &previous, nullptr);
+  }
+  EXPECT_GT(within, 100);  // both outcomes are exercised
+  EXPECT_GT(beyond, 100);
+  // A point exactly at the bound counts, as `d2 > bound` rejected nothing at the bound before:
+  // a query 0.25 m from a point with no other within 0.6 m.
+  std::size_t lonely = points.size();
+  for (std::size_t i = 0; i < points.size() && lonely == points.size(); ++i) {
+    bool alone = true;
+    for (std::size_t j = 0; j < points.size() && alone; ++j) {
+      alone = j == i || (points[j] - points[i]).norm() > 0.6;
+    }
+    if (alone) lonely = i;
+  }
+  ASSERT_LT(lonely, points.size());
+  const Eigen::Vector2d on_bound = points[lonely] + Eigen::Vector2d(0.0, 0.25);
+  const double exact_d2 = (points[lonely] - on_bound).squaredNorm();
+  std::size_t index = 0;
+  double d2 = 0.0;
+  EXPECT_TRUE(target.NearestWithin(on_bound, exact_d2, IcpTarget::kNoHint, &index, &d2));
+  EXPECT_EQ(index, lonely);
+  EXPECT_FALSE(target.NearestWithin(on_bound, std::nextafter(exact_d2, 0.0), IcpTarget::kNoHint,
+                                    &index, &d2));
+  const std::vector<Eigen::Vector2d> none;
+  EXPECT_FALSE(IcpTarget(none, IcpConfig{}).NearestWithin({0.0, 0.0}, 1.0, 0, &index, &d2));
+}
+
 TEST(IcpTest, NormalsArePerpendicularToWallsAndMissingAtCorners) {
   std::vector<Eigen::Vector2d> points;
   for (int i = 0; i <= 20; ++i) points.emplace_back(0.05 * i, 0.0);     // wall along x

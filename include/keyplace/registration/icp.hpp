@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -141,6 +142,16 @@ class IcpTarget {
   /// Index of the nearest target point and its squared distance (m^2). Returns false when the
   /// target is empty.
   bool Nearest(const Eigen::Vector2d& query, std::size_t* index, double* squared_distance_m2) const;
+  /// No hint for NearestWithin.
+  static constexpr std::size_t kNoHint = std::numeric_limits<std::size_t>::max();
+  /// As Nearest, for a point no farther than sqrt(max_squared_distance_m2): false when none is.
+  /// `hint`, an index (ignored when out of range), is a point likely near the query, such as
+  /// the answer for the previous of a scan's points; the search starts with it as the one to
+  /// beat and skips every branch of the tree farther than it, so consecutive queries of a scan
+  /// cost little (kNoHint: none). Among points equally near, which one is returned may depend on
+  /// the hint.
+  bool NearestWithin(const Eigen::Vector2d& query, double max_squared_distance_m2, std::size_t hint,
+                     std::size_t* index, double* squared_distance_m2) const;
 
  private:
   struct Impl;
