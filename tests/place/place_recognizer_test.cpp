@@ -3,11 +3,13 @@
 
 #include "keyplace/place/place_recognizer.hpp"
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "keyplace/eval/localization.hpp"
+#include "place/unique_pairs.hpp"
 
 namespace keyplace {
 namespace {
@@ -392,6 +394,46 @@ TEST(DescriptorPairs, GlobalGreedyBreaksTiesInQueryThenReferenceOrder) {
   }
   EXPECT_EQ(greedy[0].distance, 0.0);
   EXPECT_GT(greedy.back().distance, 0.0);
+}
+
+// UniquePairs takes the pairs in chunks; on random pair lists with many ties (distances from a
+// few values), of every size around the chunk, it takes what one stable sort and one pass take.
+TEST(DescriptorPairs, GlobalGreedyEqualsOneSortedPass) {
+  std::mt19937 rng(31);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n_current = 1 + static_cast<int>(rng() % 90);
+    const int n_reference = 1 + static_cast<int>(rng() % 90);
+    const double keep = std::uniform_real_distribution<double>(0.05, 0.6)(rng);
+    std::vector<DescriptorPair> below;  // ordered by current, then reference, as given
+    for (int c = 0; c < n_current; ++c) {
+      for (int r = 0; r < n_reference; ++r) {
+        if (std::uniform_real_distribution<double>(0.0, 1.0)(rng) >= keep) continue;
+        below.push_back({c, r, 0.05 * static_cast<double>(rng() % 7)});
+      }
+    }
+    std::vector<DescriptorPair> sorted = below;
+    std::stable_sort(
+        sorted.begin(), sorted.end(),
+        [](const DescriptorPair& a, const DescriptorPair& b) { return a.distance < b.distance; });
+    std::vector<char> current_used(static_cast<std::size_t>(n_current), 0);
+    std::vector<char> reference_used(static_cast<std::size_t>(n_reference), 0);
+    std::vector<DescriptorPair> expected;
+    for (const DescriptorPair& pair : sorted) {
+      if (current_used[pair.current] || reference_used[pair.reference]) continue;
+      current_used[pair.current] = 1;
+      reference_used[pair.reference] = 1;
+      expected.push_back(pair);
+    }
+    const std::vector<DescriptorPair> greedy = UniquePairs(
+        below, static_cast<std::size_t>(n_current), static_cast<std::size_t>(n_reference),
+        PlaceRecognitionConfig::PairMatching::kGlobalGreedy);
+    ASSERT_EQ(greedy.size(), expected.size()) << "trial " << trial;
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      ASSERT_EQ(greedy[k].current, expected[k].current) << "trial " << trial << ", pair " << k;
+      ASSERT_EQ(greedy[k].reference, expected[k].reference) << "trial " << trial << ", pair " << k;
+      ASSERT_EQ(greedy[k].distance, expected[k].distance);
+    }
+  }
 }
 
 TEST(PlaceConfig, KeyValuesRoundTripAndErrorsNameTheField) {
