@@ -123,28 +123,38 @@ std::vector<DescriptorPair> GreedyUniquePairs(std::vector<DescriptorPair> below,
   std::vector<char> current_used(n_current, 0);
   std::vector<char> reference_used(n_reference, 0);
   std::vector<DescriptorPair> pairs;
+  using Iterator = std::vector<DescriptorPair>::iterator;
+  const auto take_sorted = [&](Iterator first, Iterator last) {
+    std::size_t taken = 0;
+    for (auto it = first; it != last; ++it) {
+      if (current_used[it->current] || reference_used[it->reference]) continue;
+      current_used[it->current] = 1;
+      reference_used[it->reference] = 1;
+      pairs.push_back(*it);
+      ++taken;
+    }
+    return taken;
+  };
   // At most min(n_current, n_reference) pairs are taken; twice that is a chunk that usually
   // leaves few pairs open.
   const std::size_t chunk = std::max<std::size_t>(64, 2 * std::min(n_current, n_reference));
   auto begin = below.begin();
   auto end = below.end();
-  while (begin != end) {
-    const auto split = static_cast<std::size_t>(end - begin) > chunk
-                           ? begin + static_cast<std::ptrdiff_t>(chunk)
-                           : end;
-    if (split != end) std::nth_element(begin, split, end, nearer);
+  while (static_cast<std::size_t>(end - begin) > chunk) {
+    const auto split = begin + static_cast<std::ptrdiff_t>(chunk);
+    std::nth_element(begin, split, end, nearer);
     std::sort(begin, split, nearer);
-    for (auto it = begin; it != split; ++it) {
-      if (current_used[it->current] || reference_used[it->reference]) continue;
-      current_used[it->current] = 1;
-      reference_used[it->reference] = 1;
-      pairs.push_back(*it);
-    }
+    const std::size_t taken = take_sorted(begin, split);
     end = std::remove_if(split, end, [&](const DescriptorPair& pair) {
       return current_used[pair.current] || reference_used[pair.reference];
     });
     begin = split;
+    // A chunk that takes few pairs (the nearest pairs crowding on a few keypoints) would make
+    // as many passes over the rest as pairs taken: the rest is then sorted once instead.
+    if (taken * 8 < chunk) break;
   }
+  std::sort(begin, end, nearer);
+  take_sorted(begin, end);
   return pairs;
 }
 

@@ -263,14 +263,22 @@ bool IcpTarget::Nearest(const Eigen::Vector2d& query, std::size_t* index,
 
 namespace {
 
-// nanoflann's result set for one neighbour that starts with a bound (and perhaps a candidate):
-// the tree search skips every branch farther than the best so far, so a good start prunes it.
+// Margins of NearestWithin's search bound over the distance it must not miss: far above the
+// rounding of the tree's branch bounds (sums of a few squares of metres) and far below any
+// spacing of laser points (1e-9 m^2: 0.03 mm).
+constexpr double kBoundMarginRelative = 1e-9;
+constexpr double kBoundMarginM2 = 1e-9;
+
+// nanoflann's result set for one neighbour under a bound: the tree search skips every branch
+// farther than the best so far, so a tight bound from the start prunes most of it.
 class BoundedNearest {
  public:
-  BoundedNearest(double bound_d2, std::size_t candidate, bool has_candidate)
-      : best_d2_(bound_d2), best_index_(candidate), found_(has_candidate) {}
+  explicit BoundedNearest(double bound_d2) : best_d2_(bound_d2) {}
   bool addPoint(double d2, std::size_t index) {
-    if (d2 < best_d2_) {  // the tree passes only points below worstDist(); kept for clarity
+    // Needed: the tree reads worstDist() once per leaf and passes every point of the leaf below
+    // that. Strictly nearer only, so the first of equally near points found is kept, as with
+    // nanoflann's own result set.
+    if (d2 < best_d2_) {
       best_d2_ = d2;
       best_index_ = index;
       found_ = true;
@@ -283,8 +291,8 @@ class BoundedNearest {
 
  private:
   double best_d2_;
-  std::size_t best_index_;
-  bool found_;
+  std::size_t best_index_ = 0;
+  bool found_ = false;
 };
 
 }  // namespace
@@ -294,20 +302,20 @@ bool IcpTarget::NearestWithin(const Eigen::Vector2d& query, double max_squared_d
                               double* squared_distance_m2) const {
   const std::vector<Eigen::Vector2d>& points = impl_->points;
   if (points.empty() || !(max_squared_distance_m2 >= 0.0)) return false;
-  // The tree keeps only points strictly below the bound; a point at the bound itself counts.
-  double bound_d2 =
-      std::nextafter(max_squared_distance_m2, std::numeric_limits<double>::infinity());
-  bool has_candidate = false;
+  // The tree prunes a branch by a lower bound of its distance that it sums up with rounding, so
+  // a bound as tight as the nearest point's distance could prune that point's branch: the bound
+  // keeps a margin above the limit (or the hint's distance), far below the points' spacing,
+  // and the limit is checked after. The branches it prunes hold no point as near as the
+  // nearest, and the tree visits the rest in its usual order: the answer, among equally near
+  // points too, is the unbounded search's (Nearest) when that lies within the limit.
+  double bound_d2 = max_squared_distance_m2;
   if (hint < points.size()) {
-    const double hint_d2 = (points[hint] - query).squaredNorm();
-    if (hint_d2 <= max_squared_distance_m2) {
-      bound_d2 = hint_d2;
-      has_candidate = true;
-    }
+    // The tree's own formula, so that the hint's distance is the one the tree compares.
+    bound_d2 = std::min(bound_d2, impl_->tree.distance.evalMetric(query.data(), hint, 2));
   }
-  BoundedNearest result(bound_d2, hint, has_candidate);
+  BoundedNearest result(bound_d2 * (1.0 + kBoundMarginRelative) + kBoundMarginM2);
   impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
-  if (!result.full()) return false;
+  if (!result.full() || result.worstDist() > max_squared_distance_m2) return false;
   if (index != nullptr) *index = result.best_index();
   if (squared_distance_m2 != nullptr) *squared_distance_m2 = result.worstDist();
   return true;

@@ -160,6 +160,11 @@ LoopRefinement RefineLoopAgainst(const SubmapCloud& reference, const SubmapCloud
 LoopRefinement RefineLoop(const SubmapCloud& reference, const SubmapCloud& current,
                           const Pose2& T_ref_cur_initial, const LoopRefinementConfig& config) {
   Validate(config);
+  if (reference.points.empty() || current.points.empty()) {
+    LoopRefinement result;
+    result.T_ref_cur = T_ref_cur_initial;
+    return result;
+  }
   const IcpTarget target_cur(current.points, current.normals, config.icp);
   return RefineLoopAgainst(reference, current, target_cur, T_ref_cur_initial, config);
 }

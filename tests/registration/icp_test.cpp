@@ -305,8 +305,8 @@ TEST(IcpTest, NearestWithinMatchesBruteForceWhateverTheHint) {
       const bool found = target.NearestWithin(query, bound_d2, hint, &index, &d2);
       ASSERT_EQ(found, best <= bound_d2) << "query " << q << ", hint " << hint;
       if (!found) continue;
-      EXPECT_EQ(d2, best);
-      EXPECT_EQ((points[index] - query).squaredNorm(), best);
+      EXPECT_DOUBLE_EQ(d2, best);
+      EXPECT_DOUBLE_EQ((points[index] - query).squaredNorm(), best);
     }
     if (best <= bound_d2) {
       ++within;
@@ -338,6 +338,50 @@ TEST(IcpTest, NearestWithinMatchesBruteForceWhateverTheHint) {
                                     &index, &d2));
   const std::vector<Eigen::Vector2d> none;
   EXPECT_FALSE(IcpTarget(none, IcpConfig{}).NearestWithin({0.0, 0.0}, 1.0, 0, &index, &d2));
+}
+
+// Among equally near points NearestWithin returns the one Nearest returns, whatever the hint:
+// points on a grid, each twice, queried at grid points, cell centres and edge midpoints (four or
+// eight points equally near), with the hint on one of the others.
+TEST(IcpTest, NearestWithinPicksWhatNearestPicksAmongEquallyNearPoints) {
+  std::vector<Eigen::Vector2d> points;
+  for (int copy = 0; copy < 2; ++copy) {
+    for (int i = 0; i < 30; ++i) {
+      for (int j = 0; j < 30; ++j) points.emplace_back(0.25 * i, 0.25 * j);
+    }
+  }
+  const IcpTarget target(points, IcpConfig{});
+  int ties_checked = 0;
+  for (int i = 1; i < 28; i += 3) {
+    for (int j = 1; j < 28; j += 2) {
+      for (const Eigen::Vector2d& offset :
+           {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.125, 0.125),
+            Eigen::Vector2d(0.125, 0.0)}) {
+        const Eigen::Vector2d query = Eigen::Vector2d(0.25 * i, 0.25 * j) + offset;
+        std::size_t expected = 0;
+        double expected_d2 = 0.0;
+        ASSERT_TRUE(target.Nearest(query, &expected, &expected_d2));
+        for (std::size_t hint = 0; hint < points.size(); hint += 1 + points.size() / 37) {
+          if ((points[hint] - query).squaredNorm() != expected_d2) continue;
+          ++ties_checked;
+          std::size_t index = 0;
+          double d2 = 0.0;
+          ASSERT_TRUE(target.NearestWithin(query, 0.5, hint, &index, &d2));
+          EXPECT_EQ(index, expected) << "query " << query.transpose() << ", hint " << hint;
+          EXPECT_EQ(d2, expected_d2);
+        }
+        // Equally near duplicates of the answer and its neighbours as hints, and no hint.
+        for (const std::size_t hint :
+             {expected, (expected + 900) % points.size(), IcpTarget::kNoHint}) {
+          std::size_t index = 0;
+          ASSERT_TRUE(target.NearestWithin(query, 0.5, hint, &index, nullptr));
+          EXPECT_EQ(index, expected) << "query " << query.transpose() << ", hint " << hint;
+          ++ties_checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(ties_checked, 500);
 }
 
 TEST(IcpTest, NormalsArePerpendicularToWallsAndMissingAtCorners) {

@@ -144,12 +144,11 @@ class IcpTarget {
   bool Nearest(const Eigen::Vector2d& query, std::size_t* index, double* squared_distance_m2) const;
   /// No hint for NearestWithin.
   static constexpr std::size_t kNoHint = std::numeric_limits<std::size_t>::max();
-  /// As Nearest, for a point no farther than sqrt(max_squared_distance_m2): false when none is.
-  /// `hint`, an index (ignored when out of range), is a point likely near the query, such as
-  /// the answer for the previous of a scan's points; the search starts with it as the one to
-  /// beat and skips every branch of the tree farther than it, so consecutive queries of a scan
-  /// cost little (kNoHint: none). Among points equally near, which one is returned may depend on
-  /// the hint.
+  /// As Nearest, for a point no farther than sqrt(max_squared_distance_m2): false when none is,
+  /// and otherwise the same point as Nearest (among equally near ones too). `hint`, an index
+  /// (ignored when out of range; kNoHint: none), is a point likely near the query, such as the
+  /// answer for the previous of a scan's points: its distance bounds the tree search from the
+  /// start, so consecutive queries of a scan cost little.
   bool NearestWithin(const Eigen::Vector2d& query, double max_squared_distance_m2, std::size_t hint,
                      std::size_t* index, double* squared_distance_m2) const;
 
