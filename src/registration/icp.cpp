@@ -321,6 +321,27 @@ bool IcpTarget::NearestWithin(const Eigen::Vector2d& query, double max_squared_d
   return true;
 }
 
+IcpInliers CountIcpInliers(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
+                           const Pose2& T_target_source, const IcpConfig& config) {
+  const double gate_d2 =
+      config.max_correspondence_distance_m * config.max_correspondence_distance_m;
+  IcpInliers inliers;
+  std::size_t index = IcpTarget::kNoHint;  // the previous point's neighbour, near the next one's
+  const PointMapper to_target(T_target_source);
+  for (const Eigen::Vector2d& p : source) {
+    const Eigen::Vector2d pt = to_target(p);
+    double d2 = 0.0;
+    if (!target.NearestWithin(pt, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
+      continue;
+    }
+    const double r = target.normal(index).dot(pt - target.points()[index]);
+    if (std::abs(r) > config.inlier_distance_m) continue;
+    ++inliers.count;
+    inliers.sum_squared_residuals_m2 += r * r;
+  }
+  return inliers;
+}
+
 // ------------------------------------------------------------------------------------------
 // Alignment
 
@@ -375,8 +396,8 @@ IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vec
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     int count = 0;
-    std::size_t index =
-        IcpTarget::kNoHint;  // the previous point's neighbour: the next one's is near it
+    // The previous point's neighbour: the next one's is near it.
+    std::size_t index = IcpTarget::kNoHint;
     for (const Eigen::Vector2d& p : source) {
       // Source point relative to the sensor origin, rotated into the target frame.
       const Eigen::Vector2d rp(c * p.x() - s * p.y(), s * p.x() + c * p.y());
@@ -459,25 +480,12 @@ IcpResult AlignPointToLine(const IcpTarget& target, const std::vector<Eigen::Vec
   }
 
   const Pose2 estimate(x, y, theta);
-  // Final statistics at the estimate.
-  int inliers = 0;
-  double sum_r2 = 0.0;
-  std::size_t index = IcpTarget::kNoHint;
-  const PointMapper to_target(estimate);
-  for (const Eigen::Vector2d& p : source) {
-    const Eigen::Vector2d pt = to_target(p);
-    double d2 = 0.0;
-    if (!target.NearestWithin(pt, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
-      continue;
-    }
-    const double r = target.normal(index).dot(pt - target.points()[index]);
-    if (std::abs(r) > config.inlier_distance_m) continue;
-    ++inliers;
-    sum_r2 += r * r;
-  }
+  const IcpInliers final_inliers = CountIcpInliers(target, source, estimate, config);
+  const int inliers = final_inliers.count;
   result.num_inliers = inliers;
   result.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(source.size());
-  result.residual_rms_m = inliers > 0 ? std::sqrt(sum_r2 / inliers) : 0.0;
+  result.residual_rms_m =
+      inliers > 0 ? std::sqrt(final_inliers.sum_squared_residuals_m2 / inliers) : 0.0;
 
   if (singular) {
     result.status = IcpStatus::kSingular;

@@ -16,33 +16,12 @@ std::uint64_t VoxelKey(const Eigen::Vector2d& p, double voxel_m) {
          static_cast<std::uint32_t>(j);
 }
 
-// Source points (mapped by T_target_source) within inlier_distance_m of the target's line at
-// their nearest target point (within max_correspondence_distance_m, with a normal).
-int CountInliers(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
-                 const Pose2& T_target_source, const IcpConfig& icp) {
-  const double gate_d2 = icp.max_correspondence_distance_m * icp.max_correspondence_distance_m;
-  int inliers = 0;
-  std::size_t index = IcpTarget::kNoHint;  // the previous point's neighbour: the next one's is near
-  const PointMapper to_target(T_target_source);
-  for (const Eigen::Vector2d& p : source) {
-    const Eigen::Vector2d q = to_target(p);
-    double d2 = 0.0;
-    if (!target.NearestWithin(q, gate_d2, index, &index, &d2) || !target.HasNormal(index)) {
-      continue;
-    }
-    if (std::abs(target.normal(index).dot(q - target.points()[index])) <= icp.inlier_distance_m) {
-      ++inliers;
-    }
-  }
-  return inliers;
-}
-
 double Overlap(const IcpTarget& a, const SubmapCloud& a_cloud, const IcpTarget& b,
                const SubmapCloud& b_cloud, const Pose2& T_a_b, const IcpConfig& icp) {
   const std::size_t total = a_cloud.points.size() + b_cloud.points.size();
   if (total == 0) return 0.0;
-  const int b_in_a = CountInliers(a, b_cloud.points, T_a_b, icp);
-  const int a_in_b = CountInliers(b, a_cloud.points, T_a_b.inverse(), icp);
+  const int b_in_a = CountIcpInliers(a, b_cloud.points, T_a_b, icp).count;
+  const int a_in_b = CountIcpInliers(b, a_cloud.points, T_a_b.inverse(), icp).count;
   return static_cast<double>(b_in_a + a_in_b) / static_cast<double>(total);
 }
 
@@ -132,7 +111,7 @@ LoopRefinement RefineLoopAgainst(const SubmapCloud& reference, const SubmapCloud
   const IcpTarget target_ref(reference.points, reference.normals, config.icp);
   const double n_cur = static_cast<double>(current.points.size());
   result.inlier_ratio_initial =
-      CountInliers(target_ref, current.points, T_ref_cur_initial, config.icp) / n_cur;
+      CountIcpInliers(target_ref, current.points, T_ref_cur_initial, config.icp).count / n_cur;
   result.inlier_ratio = result.inlier_ratio_initial;
   if (config.refine) {
     const IcpResult icp =

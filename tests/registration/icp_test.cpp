@@ -262,17 +262,32 @@ TEST(IcpTest, EmptyAndTinyInputsGiveAClearResult) {
   EXPECT_DOUBLE_EQ(far.T_target_source.x, 100.0);
 }
 
+// `count` points uniform over [-10, 10]^2, drawn from `u` (the tests draw their queries from it
+// after).
+std::vector<Eigen::Vector2d> UniformPoints(std::mt19937& rng,
+                                           std::uniform_real_distribution<double>& u, int count) {
+  std::vector<Eigen::Vector2d> points(static_cast<std::size_t>(count));
+  for (auto& p : points) p = {u(rng), u(rng)};
+  return points;
+}
+
+// The squared distance from `query` to its nearest point, by a scan of every point.
+double NearestSquaredDistance(const std::vector<Eigen::Vector2d>& points,
+                              const Eigen::Vector2d& query) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
+  return best;
+}
+
 TEST(IcpTest, KdTreeNearestMatchesBruteForce) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-10.0, 10.0);
-  std::vector<Eigen::Vector2d> points(2000);
-  for (auto& p : points) p = {u(rng), u(rng)};
+  const std::vector<Eigen::Vector2d> points = UniformPoints(rng, u, 2000);
   const IcpTarget target(points, IcpConfig{});
   EXPECT_EQ(&target.points(), &points);  // an adaptor over the caller's points, no copy
   for (int q = 0; q < 500; ++q) {
     const Eigen::Vector2d query(u(rng) * 1.2, u(rng) * 1.2);
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
+    const double best = NearestSquaredDistance(points, query);
     std::size_t index = 0;
     double d2 = 0.0;
     ASSERT_TRUE(target.Nearest(query, &index, &d2));
@@ -287,8 +302,7 @@ TEST(IcpTest, KdTreeNearestMatchesBruteForce) {
 TEST(IcpTest, NearestWithinMatchesBruteForceWhateverTheHint) {
   std::mt19937 rng(12);
   std::uniform_real_distribution<double> u(-10.0, 10.0);
-  std::vector<Eigen::Vector2d> points(2000);
-  for (auto& p : points) p = {u(rng), u(rng)};
+  const std::vector<Eigen::Vector2d> points = UniformPoints(rng, u, 2000);
   const IcpTarget target(points, IcpConfig{});
   const double bound_d2 = 0.04;
   std::size_t previous = IcpTarget::kNoHint;
@@ -296,8 +310,7 @@ TEST(IcpTest, NearestWithinMatchesBruteForceWhateverTheHint) {
   int beyond = 0;
   for (int q = 0; q < 2000; ++q) {
     const Eigen::Vector2d query(u(rng) * 1.2, u(rng) * 1.2);
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
+    const double best = NearestSquaredDistance(points, query);
     const std::size_t far_point = static_cast<std::size_t>(q) % points.size();
     for (const std::size_t hint : {previous, far_point, IcpTarget::kNoHint, points.size() + 3}) {
       std::size_t index = 0;

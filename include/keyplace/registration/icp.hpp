@@ -157,6 +157,17 @@ class IcpTarget {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The source points (mapped by T_target_source) that ICP counts as inliers there: a nearest
+/// target point within max_correspondence_distance_m, with a normal, and a point-to-line
+/// distance of at most inlier_distance_m; and the sum of those squared distances (m^2). What
+/// AlignPointToLine reports at its estimate, and what loop refinement counts for its overlap.
+struct IcpInliers {
+  int count = 0;
+  double sum_squared_residuals_m2 = 0.0;
+};
+IcpInliers CountIcpInliers(const IcpTarget& target, const std::vector<Eigen::Vector2d>& source,
+                           const Pose2& T_target_source, const IcpConfig& config);
+
 /// A Gaussian prior on the estimated pose, such as the wheel odometry's prediction: the cost gains
 /// e^T information e / 2 with e = (x, y, theta) of the estimate minus those of the mean, in the
 /// target frame. The information is in the units of the point-to-line cost, where one point with
