@@ -363,6 +363,46 @@ TEST(FixFilter, AnEarlierWeakAnswerOfTheQueryIsReplacedNotContradicted) {
   EXPECT_TRUE(filter.Update(AnswerOfQuery(kTrue, 2), Odometry(8)).new_fix);
 }
 
+// A query that grows answers again every metre; scans added since its answer that let it name no
+// place (more unmapped ground lowers its coverage) take nothing back from what its earlier scans
+// said. Open halls (acapulco): an answer's query grows for about ten metres, most of them silent.
+LocalizationResult SilentAnswerOfQuery(long long query_id) {
+  LocalizationResult answer;
+  answer.query_id = query_id;
+  return answer;
+}
+
+TEST(FixFilter, ALaterSilenceOfTheQueryKeepsItsAnswer) {
+  FixFilter filter;
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(SilentAnswerOfQuery(1), Odometry(4));
+  filter.Update(SilentAnswerOfQuery(1), Odometry(8));
+  ASSERT_EQ(filter.Beliefs().size(), 1U);
+  const RelocalizationUpdate update = filter.Update(AnswerOfQuery(kTrue, 2), Odometry(12));
+  EXPECT_TRUE(update.new_fix);
+}
+
+TEST(FixFilter, WeakAnswersKeptThroughSilencesAddUpAlongAPath) {
+  FixFilter filter;
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(0));
+  filter.Update(SilentAnswerOfQuery(1), Odometry(8));
+  filter.Update(WeakAnswer(kTrue, 2), Odometry(20));
+  filter.Update(SilentAnswerOfQuery(2), Odometry(28));
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 3), Odometry(44)).new_fix);  // 11 m from the first
+}
+
+// An ambiguous answer says the query sees a place that looks like another: what it said before
+// is withdrawn.
+TEST(FixFilter, ALaterAmbiguityOfTheQueryWithdrawsItsAnswer) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  LocalizationResult ambiguous = SilentAnswerOfQuery(1);
+  ambiguous.ambiguous = true;
+  filter.Update(ambiguous, Odometry(4));
+  EXPECT_TRUE(filter.Beliefs().empty());
+  EXPECT_EQ(filter.Update(AnswerOfQuery(kTrue, 2), Odometry(8)).status, FixStatus::kSearching);
+}
+
 TEST_F(FixedFilter, AWeakAnswerConfirmsTheFix) {
   for (int scan = 6; scan < 40; ++scan) filter_.Update(std::nullopt, Odometry(scan));
   const RelocalizationUpdate update = filter_.Update(WeakAnswer(kTrue), Odometry(40));
