@@ -36,6 +36,9 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              s.starts_with_revisit, o.revisit_m, o.revisit_deg, o.give_up_m);
   fmt::print("fixed        {:.3f} of starts with a revisit ({}/{}); {} starts in all\n",
              s.fixed_fraction, s.fixed_with_revisit, s.starts_with_revisit, s.fixed);
+  fmt::print(
+      "with room    {:.3f} of the starts with at least {} m of path after the revisit ({}/{})\n",
+      s.fixed_fraction_with_room, o.revisit_room_m, s.fixed_with_room, s.starts_with_room);
   fmt::print("to first fix median {:.2f} m, 90th percentile {:.2f} m, median {:.0f} scans\n",
              s.distance_to_fix_median_m, s.distance_to_fix_p90_m, s.scans_to_fix_median);
   fmt::print("after known  median {:.2f} m, 90th percentile {:.2f} m from the first mapped place\n",

@@ -29,6 +29,8 @@ const ConfigFields<EvaluationConfig>& EvaluationConfigFields() {
                 "relocalize: a start without a fix is given up after this odometry distance")
         .Double("follow_m", &C::follow_m, "m",
                 "relocalize: fixes are checked over this distance after the first one")
+        .Double("revisit_room_m", &C::revisit_room_m, "m",
+                "relocalize: a start with a revisit has room with this much path left after it")
         .Double("grid_tolerance_m", &C::grid_tolerance_m, "m",
                 "slam --grid: occupied cells agree with the corrected-pose grid within this");
     return table;
@@ -55,6 +57,9 @@ void Validate(const EvaluationConfig& config) {
   if (!(config.give_up_m > 0.0) || !(config.follow_m >= 0.0)) {
     throw std::invalid_argument(
         "EvaluationConfig.give_up_m must be positive and EvaluationConfig.follow_m >= 0");
+  }
+  if (!(config.revisit_room_m >= 0.0)) {
+    throw std::invalid_argument("EvaluationConfig.revisit_room_m must be >= 0");
   }
   if (!(config.revisit_radius_m >= 0.0)) {
     throw std::invalid_argument("EvaluationConfig.revisit_radius_m must be >= 0");

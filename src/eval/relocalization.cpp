@@ -128,18 +128,21 @@ class StartRun {
 
  private:
   // The first scan before the give-up distance whose true pose the map has seen: whether the
-  // start can be fixed at all, whatever the localizer does.
+  // start can be fixed at all, whatever the localizer does; and the path left after it.
   void FindRevisit() {
     double travelled_m = 0.0;
     for (auto k = static_cast<std::size_t>(record_.start_scan); k < inputs_.log.scans.size(); ++k) {
       if (k > static_cast<std::size_t>(record_.start_scan)) {
         travelled_m += TranslationNorm(Between(inputs_.poses[k - 1], inputs_.poses[k]));
       }
-      if (travelled_m > options_.give_up_m) return;
-      if (truth_.Has(k) && revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k))) {
+      if (travelled_m > options_.give_up_m) break;
+      if (!record_.revisit && truth_.Has(k) &&
+          revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k))) {
         record_.revisit = true;
         record_.distance_to_revisit_m = travelled_m;
-        return;
+      }
+      if (record_.revisit) {
+        record_.room_after_revisit_m = travelled_m - record_.distance_to_revisit_m;
       }
     }
   }
@@ -159,6 +162,7 @@ class StartRun {
     if (!update.answer) return;
     ++record_.answers;
     if (update.answer->found) ++record_.answers_accepted;
+    if (!update.answer->found && update.answer->weak_T_world_odom) ++record_.answers_weak;
     if (update.status != FixStatus::kFixed) return;
     const bool first = !record_.fixed && update.new_fix;
     if (first) {
@@ -246,9 +250,12 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   std::size_t updates = 0;
   for (const StartRecord& r : records) {
     s.starts_with_revisit += r.revisit ? 1 : 0;
+    const bool room = r.revisit && r.room_after_revisit_m >= options.revisit_room_m;
+    s.starts_with_room += room ? 1 : 0;
     if (r.fixed) {
       ++s.fixed;
       s.fixed_with_revisit += r.revisit ? 1 : 0;
+      s.fixed_with_room += room ? 1 : 0;
       distances.push_back(r.distance_to_fix_m);
       if (r.revisit)
         after_revisit.push_back(std::max(0.0, r.distance_to_fix_m - r.distance_to_revisit_m));
@@ -273,6 +280,9 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   if (s.starts_with_revisit > 0) {
     s.fixed_fraction = static_cast<double>(s.fixed_with_revisit) / s.starts_with_revisit;
   }
+  if (s.starts_with_room > 0) {
+    s.fixed_fraction_with_room = static_cast<double>(s.fixed_with_room) / s.starts_with_room;
+  }
   if (s.fixes > 0) s.wrong_fix_rate = static_cast<double>(s.wrong_fixes) / s.fixes;
   s.distance_to_fix_median_m = Quantile(distances, 0.5);
   s.distance_to_fix_p90_m = Quantile(distances, 0.9);
@@ -295,6 +305,7 @@ RelocalizationOptions RelocalizationOptionsFor(const EvaluationConfig& evaluatio
   options.follow_m = evaluation.follow_m;
   options.revisit_m = evaluation.revisit_radius_m;
   options.revisit_deg = evaluation.revisit_angle_deg;
+  options.revisit_room_m = evaluation.revisit_room_m;
   options.truth_max_gap_scans = evaluation.truth_max_gap_scans;
   options.exclude_shared_scans = shared_scan_rule && query_log_is_map_log;
   return options;

@@ -18,6 +18,11 @@ const ResultFields<RelocalizationSummary>& RelocalizationSummaryFields() {
         .Count("fixed_with_revisit", &S::fixed_with_revisit, "... of the starts with a revisit")
         .Number("fixed_fraction", &S::fixed_fraction, "",
                 "fixed_with_revisit / starts_with_revisit")
+        .Count("starts_with_room", &S::starts_with_room,
+               "starts with a revisit and at least revisit_room_m of path left after it")
+        .Count("fixed_with_room", &S::fixed_with_room, "... of them with a first fix")
+        .Number("fixed_fraction_with_room", &S::fixed_fraction_with_room, "",
+                "fixed_with_room / starts_with_room")
         .Count("fixes", &S::fixes, "fixes reported and checked")
         .Count("wrong_fixes", &S::wrong_fixes, "fixes more than 0.5 m or 10 deg off the truth")
         .Number("wrong_fix_rate", &S::wrong_fix_rate, "", "wrong_fixes / fixes")
@@ -56,6 +61,8 @@ const ResultFields<StartRecord>& StartRecordFields() {
                 "its path before the cap passes a map scan the localizer may match")
         .Number("distance_to_revisit_m", &R::distance_to_revisit_m, "m",
                 "odometry distance to the first such scan")
+        .Number("room_after_revisit_m", &R::room_after_revisit_m, "m",
+                "odometry distance from that scan to where the start stops without a fix")
         .Switch("fixed", &R::fixed, "the relocalizer reported a fix")
         .Integer("scans_to_fix", &R::scans_to_fix, "scans fed up to and including the first fix")
         .Number("distance_to_fix_m", &R::distance_to_fix_m, "m",
@@ -67,6 +74,7 @@ const ResultFields<StartRecord>& StartRecordFields() {
         .Integer("answers", &R::answers, "queries answered")
         .Integer("answers_accepted", &R::answers_accepted,
                  "... of them accepted by the place recognizer")
+        .Integer("answers_weak", &R::answers_weak, "... of them not accepted but weak")
         .Add("fixes_reported", "", "fixes reported (the list is `fixes`)",
              [](const R& r) -> ResultValue { return CountValue(r.fixes.size()); })
         .Integer("wrong_fixes", &R::wrong_fixes, "fixes more than 0.5 m or 10 deg off the truth")

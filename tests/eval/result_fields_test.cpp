@@ -38,9 +38,12 @@ TEST(ResultFields, RelocalizationSummaryFiguresReadTheirOwnMembers) {
   s.lost_signals = 8;
   s.lost_on_correct_track = 9;
   s.lost_on_wrong_track = 10;
+  s.starts_with_room = 11;
+  s.fixed_with_room = 12;
+  s.fixed_fraction_with_room = 0.125;
   const ResultFields<RelocalizationSummary>& fields = RelocalizationSummaryFields();
   ExpectWellFormed(fields, s);
-  EXPECT_EQ(fields.fields().size(), 21u);  // every figure of the struct
+  EXPECT_EQ(fields.fields().size(), 24u);  // every figure of the struct
   EXPECT_EQ(ValueOf(fields, s, "wrong_fixes"), ResultValue(std::int64_t{6}));
   EXPECT_EQ(ValueOf(fields, s, "distance_to_fix_p90_m"), ResultValue(2.5));
   EXPECT_EQ(ValueOf(fields, s, "wrong_fix_confident"), ResultValue(true));
@@ -136,10 +139,12 @@ TEST(ResultFields, StartRecordAndFixEventFiguresReadTheirOwnMembers) {
   r.end_scan = 2;
   r.revisit = true;
   r.distance_to_revisit_m = 0.5;
+  r.room_after_revisit_m = 4.5;
   r.scans_to_fix = 3;
   r.distance_to_fix_m = 1.5;
   r.answers = 4;
   r.answers_accepted = 5;
+  r.answers_weak = 11;
   r.fixes.resize(6);
   r.wrong_fixes = 7;
   r.lost = 8;
@@ -150,7 +155,7 @@ TEST(ResultFields, StartRecordAndFixEventFiguresReadTheirOwnMembers) {
   // The three other switches stay false: ExpectWellFormed needs one value per figure, so they are
   // checked one by one.
   const ResultFields<StartRecord>& fields = StartRecordFields();
-  EXPECT_EQ(fields.fields().size(), 18u);
+  EXPECT_EQ(fields.fields().size(), 20u);
   EXPECT_EQ(ValueOf(fields, r, "fixes_reported"), ResultValue(std::int64_t{6}));
   for (bool StartRecord::*member :
        {&StartRecord::fixed, &StartRecord::first_fix_checked, &StartRecord::first_fix_correct}) {

@@ -16,7 +16,8 @@ STARTS = 6
 
 # The summary figures of --json the evaluation holds under the same names (times aside).
 FIGURES = [
-    "starts", "starts_with_revisit", "fixed", "fixed_with_revisit", "fixed_fraction", "fixes",
+    "starts", "starts_with_revisit", "fixed", "fixed_with_revisit", "fixed_fraction",
+    "starts_with_room", "fixed_with_room", "fixed_fraction_with_room", "fixes",
     "wrong_fixes", "wrong_fix_rate", "wrong_first_fixes", "wrong_fix_confident",
     "wrong_fix_confidence_max", "distance_to_fix_median_m", "distance_to_fix_p90_m",
     "scans_to_fix_median", "distance_after_revisit_median_m", "distance_after_revisit_p90_m",

@@ -27,6 +27,12 @@ struct EvaluationConfig {
   // after its first fix the fixes are checked over this further distance.
   double give_up_m = 50.0;
   double follow_m = 20.0;
+  // keyplace relocalize: a start with a revisit has room when the path it has left after the
+  // first scan the map has seen (before give_up_m or the log's end) is at least this long. Its
+  // fixed fraction is reported beside the plain one: a start that meets the map a few metres
+  // before it stops has no fair chance. 10 m is the path a fix of weak answers alone needs
+  // (FixPolicy::weak_fix_span_m).
+  double revisit_room_m = 10.0;
   // keyplace slam --grid with --truth: an occupied cell agrees with the reference grid when an
   // occupied reference cell lies within this (two cells of the default grid).
   double grid_tolerance_m = 0.1;

@@ -33,6 +33,9 @@ struct RelocalizationOptions {
   double correct_deg = 10.0;
   double revisit_m = 1.5;  // a start has a revisit when its path comes this close to a map scan
   double revisit_deg = 45.0;
+  // A start with a revisit has room when it has at least this much path left after the revisit
+  // (evaluation.revisit_room_m).
+  double revisit_room_m = 10.0;
   double confident = 0.9;  // a fix at least this confident is "confident"
   // A fix is checked at the nearest scan with a truth pose at most this many scans away
   // (evaluation.truth_max_gap_scans); fixes with none are not counted.
@@ -67,6 +70,9 @@ struct StartRecord {
   int end_scan = 0;      // one past the last scan fed
   bool revisit = false;  // the path before the cap passes a map scan the localizer may match
   double distance_to_revisit_m = 0.0;  // odometry distance to the first such scan
+  // Odometry distance from that scan to where the start stops without a fix (give_up_m or the
+  // log's end): the path the localizer has on ground the map has seen, at most.
+  double room_after_revisit_m = 0.0;
   bool fixed = false;
   int scans_to_fix = 0;  // scans fed up to and including the first fix
   double distance_to_fix_m = 0.0;
@@ -74,6 +80,7 @@ struct StartRecord {
   bool first_fix_correct = false;
   int answers = 0;           // queries answered
   int answers_accepted = 0;  // of them accepted by the place recognizer
+  int answers_weak = 0;      // of them not accepted but naming a weak answer
   std::vector<FixEvent> fixes;
   int wrong_fixes = 0;
   int lost = 0;                   // "lost" signals
@@ -89,6 +96,10 @@ struct RelocalizationSummary {
   std::size_t fixed = 0;               // starts with a first fix
   std::size_t fixed_with_revisit = 0;  // of the starts with a revisit
   double fixed_fraction = 0.0;         // fixed_with_revisit / starts_with_revisit
+  // The same over the starts with room after their revisit (RelocalizationOptions::revisit_room_m).
+  std::size_t starts_with_room = 0;
+  std::size_t fixed_with_room = 0;
+  double fixed_fraction_with_room = 0.0;
   std::size_t fixes = 0;
   std::size_t wrong_fixes = 0;
   double wrong_fix_rate = 0.0;            // wrong_fixes / fixes

@@ -1,0 +1,84 @@
+// The kidnapped-robot benchmark's figures that say whether a start had a fair chance: the path a
+// start has left after it first meets ground the map has seen (StartRecord::room_after_revisit_m)
+// and the fixed fraction over the starts with room (RelocalizationSummary::fixed_with_room).
+
+#include <cstddef>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "keyplace/eval/relocalization.hpp"
+#include "support/bundled_map.hpp"
+
+namespace keyplace {
+namespace {
+
+StartRecord StartWith(bool revisit, double room_m, bool fixed) {
+  StartRecord record;
+  record.revisit = revisit;
+  record.room_after_revisit_m = room_m;
+  record.fixed = fixed;
+  return record;
+}
+
+TEST(RelocalizationSummary, TheFixedFractionWithRoomCountsStartsWithRoomAfterTheirRevisitOnly) {
+  RelocalizationOptions options;
+  options.revisit_room_m = 10.0;
+  const std::vector<StartRecord> records = {
+      StartWith(true, 2.0, false),    // met the map 2 m before it stopped: no room
+      StartWith(true, 10.0, true),    // room, fixed
+      StartWith(true, 30.0, false),   // room, not fixed
+      StartWith(false, 40.0, false),  // no revisit: never counts
+      StartWith(true, 1.0, true),     // fixed without room: counts in the plain fraction only
+  };
+  const RelocalizationSummary s = SummarizeRelocalization(records, options);
+  EXPECT_EQ(s.starts_with_revisit, 4U);
+  EXPECT_EQ(s.fixed_with_revisit, 2U);
+  EXPECT_DOUBLE_EQ(s.fixed_fraction, 0.5);
+  EXPECT_EQ(s.starts_with_room, 2U);
+  EXPECT_EQ(s.fixed_with_room, 1U);
+  EXPECT_DOUBLE_EQ(s.fixed_fraction_with_room, 0.5);
+
+  options.revisit_room_m = 0.0;  // every start with a revisit has room
+  const RelocalizationSummary all = SummarizeRelocalization(records, options);
+  EXPECT_EQ(all.starts_with_room, all.starts_with_revisit);
+  EXPECT_DOUBLE_EQ(all.fixed_fraction_with_room, all.fixed_fraction);
+}
+
+double PathMetres(const std::vector<Pose2>& poses, std::size_t from, std::size_t to) {
+  double metres = 0.0;
+  for (std::size_t k = from + 1; k <= to; ++k) {
+    metres += TranslationNorm(Between(poses[k - 1], poses[k]));
+  }
+  return metres;
+}
+
+// A start that is never fixed runs until the give-up distance or the log's end: the room after
+// its revisit is the path from the revisit to the last scan it was fed (the benchmark's feed
+// and the revisit search stop by one rule; the log's end is not reached here, a run to it costs
+// 15 s). A place recognizer that
+// needs more inliers than a place holds keypoints answers nothing, so no start is fixed.
+TEST(Relocalization, RoomAfterRevisitIsThePathAnUnfixedStartHadLeft) {
+  const testing::BundledMap& b = testing::BundledFr079();
+  RelocalizationOptions options;
+  options.starts = 12;
+  options.give_up_m = 6.0;  // every start gives up before the log's end
+  LocalizerConfig config;
+  config.place.min_consensus = 100000;
+  std::size_t with_revisit = 0;
+  for (const StartRecord& r : RunRelocalization(b.map, b.inputs, b.truth, config, options)) {
+    ASSERT_FALSE(r.fixed);
+    ASSERT_LT(r.end_scan, static_cast<int>(b.inputs.poses.size()));
+    if (!r.revisit) continue;
+    ++with_revisit;
+    const double fed_m = PathMetres(b.inputs.poses, static_cast<std::size_t>(r.start_scan),
+                                    static_cast<std::size_t>(r.end_scan - 1));
+    EXPECT_NEAR(r.distance_to_revisit_m + r.room_after_revisit_m, fed_m, 1e-9) << r.start_scan;
+    EXPECT_GE(r.room_after_revisit_m, 0.0);
+    EXPECT_LE(fed_m, options.give_up_m);
+  }
+  EXPECT_GE(with_revisit, 6U);  // the bundled log revisits most of its ground
+}
+
+}  // namespace
+}  // namespace keyplace
