@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 namespace keyplace {
@@ -131,14 +132,18 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
   last_T_odom_robot_ = T_odom_robot;
 
   RelocalizationUpdate update;
+  // Before OwnQueryAllows drops the query's earlier answers, which HypothesisOf may uphold.
+  std::optional<Hypothesis> hypothesis;
+  if (answer && (answer->found || answer->weak_T_world_odom)) {
+    hypothesis = HypothesisOf(*answer, T_odom_robot);
+  }
   if (answer && !OwnQueryAllows(*answer, T_odom_robot)) {
     update.self_contradicted = true;
-  } else if (answer && (answer->found || answer->weak_T_world_odom)) {
-    const Hypothesis hypothesis = HypothesisOf(*answer, T_odom_robot);
+  } else if (hypothesis) {
     if (status_ == FixStatus::kFixed) {
-      Track(hypothesis, T_odom_robot, update);
+      Track(*hypothesis, T_odom_robot, update);
     } else {
-      Search(hypothesis, T_odom_robot, update);
+      Search(*hypothesis, T_odom_robot, update);
     }
   }
   if (status_ == FixStatus::kFixed && odometry_m_ - confirmed_at_m_ > policy_.lost_after_m) {
@@ -178,13 +183,28 @@ FixFilter::Hypothesis FixFilter::HypothesisOf(const LocalizationResult& answer,
   const Eigen::Matrix3d covariance = answer.match.weak
                                          ? answer.match.weak->estimated_pose_covariance
                                          : Eigen::Matrix3d::Zero().eval();
-  return {*answer.weak_T_world_odom,
-          answer.match.weak_confidence,
-          odometry_m_,
-          covariance,
-          T_odom_robot,
-          answer.query_id,
-          true};
+  Hypothesis weak{*answer.weak_T_world_odom,
+                  answer.match.weak_confidence,
+                  odometry_m_,
+                  covariance,
+                  T_odom_robot,
+                  answer.query_id,
+                  true};
+  // The query was accepted at this pose before: the scans it added since lowered γ or the
+  // coverage (ground the place lacks), not the pose, so it still speaks as accepted. Replaced by
+  // its weak answer, an accepted answer of acapulco (a) could no longer second a weak one of
+  // the next query 16 m on.
+  if (answer.query_id < 0) return weak;
+  for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
+    for (const Hypothesis& earlier : *pool) {
+      if (earlier.query_id != answer.query_id || earlier.weak) continue;
+      if (!Agree(weak, earlier, T_odom_robot)) continue;
+      weak.weak = false;
+      weak.confidence = earlier.confidence;
+      return weak;
+    }
+  }
+  return weak;
 }
 
 // The fix's covariance holds at the robot's pose of its last confirmation; the robot has moved
@@ -346,8 +366,8 @@ std::vector<FixFilter::Hypothesis> FixFilter::Agreeing(const std::vector<Hypothe
 // from the most scans, replaces its older ones as evidence (an ambiguous one withdraws them). A
 // newer answer that names nothing takes nothing back: the scans added since may only cover
 // ground the map's place lacks (in open halls a query grows for about ten metres, mostly
-// silent, and withdrawing on silence left 5 of acapulco's 23 starts with a revisit unfixed that
-// agreeing answers would have fixed). A query whose accepted answers name places that disagree
+// silent: withdrawing on silence kept 7 of acapulco's 23 starts with a revisit from the fix
+// their agreeing answers made once kept). A query whose accepted answers name places that disagree
 // is itself ambiguous: two look-alike rooms seen from part of one of them. Nothing it says
 // counts any more.
 bool FixFilter::OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_odom_robot) {

@@ -403,6 +403,23 @@ TEST(FixFilter, ALaterAmbiguityOfTheQueryWithdrawsItsAnswer) {
   EXPECT_EQ(filter.Update(AnswerOfQuery(kTrue, 2), Odometry(8)).status, FixStatus::kSearching);
 }
 
+// A query accepted at a pose, then weak at the same pose once it grew over ground the place lacks,
+// still speaks as accepted: one weak answer of another query then makes the fix with it.
+TEST(FixFilter, AQuerysWeakAnswerThatAgreesWithItsAcceptedOneKeepsItAccepted) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kTrue * Pose2(0.1, 0.0, 0.0), 1), Odometry(20));
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 2), Odometry(40)).new_fix);
+}
+
+TEST(FixFilter, AQuerysWeakAnswerThatDisagreesWithItsAcceptedOneReplacesIt) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kWrong, 1), Odometry(20));
+  EXPECT_FALSE(filter.Update(WeakAnswer(kTrue, 2), Odometry(40)).new_fix);
+  EXPECT_FALSE(filter.Update(WeakAnswer(kWrong, 3), Odometry(60)).new_fix);  // two weak looks
+}
+
 TEST_F(FixedFilter, AWeakAnswerConfirmsTheFix) {
   for (int scan = 6; scan < 40; ++scan) filter_.Update(std::nullopt, Odometry(scan));
   const RelocalizationUpdate update = filter_.Update(WeakAnswer(kTrue), Odometry(40));
