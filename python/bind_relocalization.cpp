@@ -129,6 +129,8 @@ void BindRelocalizationEvaluation(py::module_& module) {
                              [](const PyRelocalization& r) { return r.options.give_up_m; })
       .def_property_readonly("follow_m",
                              [](const PyRelocalization& r) { return r.options.follow_m; })
+      .def_property_readonly("revisit_room_m",
+                             [](const PyRelocalization& r) { return r.options.revisit_room_m; })
       .def_readonly("records", &PyRelocalization::records, "One StartRecord per start.")
       .def(
           "first_fix",

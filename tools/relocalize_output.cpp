@@ -97,6 +97,7 @@ nlohmann::json RelocalizeJson(const RelocalizeReport& r) {
   json["exclude_shared_scans"] = o.exclude_shared_scans;
   json["give_up_m"] = o.give_up_m;
   json["follow_m"] = o.follow_m;
+  json["revisit_room_m"] = o.revisit_room_m;
   AddResultFields(s, RelocalizationSummaryFields(), json);
   json["keypoint_seconds_per_scan"] = r.seconds_keypoints_per_scan
                                           ? nlohmann::json(*r.seconds_keypoints_per_scan)

@@ -132,18 +132,15 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
   last_T_odom_robot_ = T_odom_robot;
 
   RelocalizationUpdate update;
-  // Before OwnQueryAllows drops the query's earlier answers, which HypothesisOf may uphold.
-  std::optional<Hypothesis> hypothesis;
-  if (answer && (answer->found || answer->weak_T_world_odom)) {
-    hypothesis = HypothesisOf(*answer, T_odom_robot);
-  }
-  if (answer && !OwnQueryAllows(*answer, T_odom_robot)) {
+  const OwnQuery own = answer ? JudgeOwnQuery(*answer, T_odom_robot) : OwnQuery::kReplaces;
+  if (own == OwnQuery::kSetAside) {
     update.self_contradicted = true;
-  } else if (hypothesis) {
+  } else if (own == OwnQuery::kReplaces && answer && (answer->found || answer->weak_T_world_odom)) {
+    const Hypothesis hypothesis = HypothesisOf(*answer, T_odom_robot);
     if (status_ == FixStatus::kFixed) {
-      Track(*hypothesis, T_odom_robot, update);
+      Track(hypothesis, T_odom_robot, update);
     } else {
-      Search(*hypothesis, T_odom_robot, update);
+      Search(hypothesis, T_odom_robot, update);
     }
   }
   if (status_ == FixStatus::kFixed && odometry_m_ - confirmed_at_m_ > policy_.lost_after_m) {
@@ -183,28 +180,13 @@ FixFilter::Hypothesis FixFilter::HypothesisOf(const LocalizationResult& answer,
   const Eigen::Matrix3d covariance = answer.match.weak
                                          ? answer.match.weak->estimated_pose_covariance
                                          : Eigen::Matrix3d::Zero().eval();
-  Hypothesis weak{*answer.weak_T_world_odom,
-                  answer.match.weak_confidence,
-                  odometry_m_,
-                  covariance,
-                  T_odom_robot,
-                  answer.query_id,
-                  true};
-  // The query was accepted at this pose before: the scans it added since lowered γ or the
-  // coverage (ground the place lacks), not the pose, so it still speaks as accepted. Replaced by
-  // its weak answer, an accepted answer of acapulco (a) could no longer second a weak one of
-  // the next query 16 m on.
-  if (answer.query_id < 0) return weak;
-  for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
-    for (const Hypothesis& earlier : *pool) {
-      if (earlier.query_id != answer.query_id || earlier.weak) continue;
-      if (!Agree(weak, earlier, T_odom_robot)) continue;
-      weak.weak = false;
-      weak.confidence = earlier.confidence;
-      return weak;
-    }
-  }
-  return weak;
+  return {*answer.weak_T_world_odom,
+          answer.match.weak_confidence,
+          odometry_m_,
+          covariance,
+          T_odom_robot,
+          answer.query_id,
+          true};
 }
 
 // The fix's covariance holds at the robot's pose of its last confirmation; the robot has moved
@@ -362,18 +344,27 @@ std::vector<FixFilter::Hypothesis> FixFilter::Agreeing(const std::vector<Hypothe
   return agreeing;
 }
 
-// A query that grows (LocalizerConfig::query_every_m) answers several times; its newest answer,
-// from the most scans, replaces its older ones as evidence (an ambiguous one withdraws them). A
-// newer answer that names nothing takes nothing back: the scans added since may only cover
-// ground the map's place lacks (in open halls a query grows for about ten metres, mostly
-// silent: withdrawing on silence kept 7 of acapulco's 23 starts with a revisit from the fix
-// their agreeing answers made once kept). A query whose accepted answers name places that disagree
-// is itself ambiguous: two look-alike rooms seen from part of one of them. Nothing it says
-// counts any more.
-bool FixFilter::OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_odom_robot) {
-  if (answer.query_id < 0) return true;
-  if (answer.query_id == self_contradicted_query_) return false;
-  if (!answer.found && !answer.weak_T_world_odom && !answer.ambiguous) return true;
+// A query that grows (LocalizerConfig::query_every_m) answers several times; a newer answer
+// that says something replaces its older ones as evidence (an ambiguous one withdraws them). A
+// newer answer that says nothing, neither accepted, weak nor ambiguous, takes nothing back: the
+// scans added since may only cover ground the place lacks; in open halls a query grows over up
+// to max_path_m (8 m) and is mostly silent, and withdrawing on silence kept 7 of acapulco's 23
+// starts with a revisit from a fix. A weak answer that agrees with the query's accepted one (not
+// yet forgotten) leaves that in place too: the added scans lowered gamma or the coverage, not the
+// pose (replaced by the weak one, an accepted answer of acapulco (a) no longer seconded the next
+// query's weak answer 16 m on). A query whose accepted answers name places that disagree is
+// itself ambiguous: two look-alike rooms seen from part of one of them. Nothing it says counts
+// any more.
+FixFilter::OwnQuery FixFilter::JudgeOwnQuery(const LocalizationResult& answer,
+                                             const Pose2& T_odom_robot) {
+  if (answer.query_id < 0) return OwnQuery::kReplaces;
+  if (answer.query_id == self_contradicted_query_) return OwnQuery::kSetAside;
+  const bool ambiguous = answer.ambiguous || answer.match.weak_ambiguous;
+  if (!answer.found && !answer.weak_T_world_odom && !ambiguous) return OwnQuery::kKeepsEarlier;
+  if (!answer.found && answer.weak_T_world_odom && !ambiguous &&
+      UpholdsItsAcceptedAnswer(answer, T_odom_robot)) {
+    return OwnQuery::kKeepsEarlier;
+  }
   const Hypothesis latest{answer.T_world_odom, answer.confidence, odometry_m_, {},
                           T_odom_robot,        answer.query_id};
   bool contradicted = false;
@@ -389,7 +380,21 @@ bool FixFilter::OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_
                 pool->end());
   }
   if (contradicted) self_contradicted_query_ = answer.query_id;
-  return !contradicted;
+  return contradicted ? OwnQuery::kSetAside : OwnQuery::kReplaces;
+}
+
+bool FixFilter::UpholdsItsAcceptedAnswer(const LocalizationResult& weak_answer,
+                                         const Pose2& T_odom_robot) const {
+  const Hypothesis weak = HypothesisOf(weak_answer, T_odom_robot);
+  for (const std::vector<Hypothesis>* pool : {&hypotheses_, &challengers_}) {
+    for (const Hypothesis& earlier : *pool) {
+      if (earlier.query_id == weak.query_id && !earlier.weak && !Forgotten(earlier) &&
+          Agree(weak, earlier, T_odom_robot)) {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 bool FixFilter::Forgotten(const Hypothesis& hypothesis) const {

@@ -579,7 +579,10 @@ void ChooseWeak(const std::vector<int>& order, const VerifiedPlaces& verified, d
     if (Distinct(*best, *candidate, config)) second = std::max(second, candidate->consensus);
   }
   const double ratio = static_cast<double>(second) / static_cast<double>(best->consensus);
-  if (second > 0 && ratio >= config.ambiguity_ratio) return;
+  if (second > 0 && ratio >= config.ambiguity_ratio) {
+    match.weak_ambiguous = true;
+    return;
+  }
   match.weak = *best;
   match.weak->verified = PassesSecondCheck(*best, min_gamma);  // at this threshold's gamma_min
   const double consensus_factor =

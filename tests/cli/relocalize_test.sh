@@ -57,12 +57,13 @@ assert abs(x - float(first['est_x'])) < 2e-3 and abs(y - float(first['est_y'])) 
 assert math.hypot(x - float(first['true_x']), y - float(first['true_y'])) < 0.5, (x, y, first)
 " "$work/fix.json" "$work/a_fixes.tsv"
 check "TSV: one row per start" test "$(($(wc -l <"$work/a.tsv") - 1))" = 12
-check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tdistance_to_revisit_m\tfixed\tscans_to_fix\tdistance_to_fix_m' \
+check "TSV columns" grep -q $'^start_scan\tend_scan\trevisit\tdistance_to_revisit_m\troom_after_revisit_m\tfixed\tscans_to_fix\tdistance_to_fix_m' \
   "$work/a.tsv"
 check "JSON (a)" /usr/bin/python3 -c "
 import json,sys
 j = json.load(open(sys.argv[1]))
-for key in ['starts', 'starts_with_revisit', 'fixed_fraction', 'wrong_fix_rate',
+for key in ['starts', 'starts_with_revisit', 'fixed_fraction', 'starts_with_room',
+            'fixed_fraction_with_room', 'revisit_room_m', 'wrong_fix_rate',
             'distance_to_fix_median_m', 'distance_to_fix_p90_m', 'update_seconds_mean',
             'update_seconds_max', 'lost_signals']:
     assert key in j, key

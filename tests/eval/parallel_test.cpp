@@ -211,6 +211,7 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
     EXPECT_EQ(p.end_scan, s.end_scan) << what;
     EXPECT_EQ(p.revisit, s.revisit) << what;
     EXPECT_EQ(p.distance_to_revisit_m, s.distance_to_revisit_m) << what;
+    EXPECT_EQ(p.room_after_revisit_m, s.room_after_revisit_m) << what;
     EXPECT_EQ(p.fixed, s.fixed) << what;
     EXPECT_EQ(p.scans_to_fix, s.scans_to_fix) << what;
     EXPECT_EQ(p.distance_to_fix_m, s.distance_to_fix_m) << what;
@@ -218,6 +219,7 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
     EXPECT_EQ(p.first_fix_correct, s.first_fix_correct) << what;
     EXPECT_EQ(p.answers, s.answers) << what;
     EXPECT_EQ(p.answers_accepted, s.answers_accepted) << what;
+    EXPECT_EQ(p.answers_weak, s.answers_weak) << what;
     EXPECT_EQ(p.wrong_fixes, s.wrong_fixes) << what;
     EXPECT_EQ(p.lost, s.lost) << what;
     EXPECT_EQ(p.lost_on_correct_track, s.lost_on_correct_track) << what;

@@ -157,6 +157,8 @@ TEST(ResultFields, StartRecordAndFixEventFiguresReadTheirOwnMembers) {
   const ResultFields<StartRecord>& fields = StartRecordFields();
   EXPECT_EQ(fields.fields().size(), 20u);
   EXPECT_EQ(ValueOf(fields, r, "fixes_reported"), ResultValue(std::int64_t{6}));
+  EXPECT_EQ(ValueOf(fields, r, "room_after_revisit_m"), ResultValue(4.5));
+  EXPECT_EQ(ValueOf(fields, r, "answers_weak"), ResultValue(std::int64_t{11}));
   for (bool StartRecord::*member :
        {&StartRecord::fixed, &StartRecord::first_fix_checked, &StartRecord::first_fix_correct}) {
     StartRecord one = r;

@@ -412,6 +412,50 @@ TEST(FixFilter, AQuerysWeakAnswerThatAgreesWithItsAcceptedOneKeepsItAccepted) {
   EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 2), Odometry(40)).new_fix);
 }
 
+// Upheld, the accepted answer stays what it was: a later accepted answer of the query is judged
+// against it, not against the weak pose (weak answers 0.9 m apart must not walk it away).
+TEST(FixFilter, AnUpheldAcceptedAnswerKeepsItsOwnPose) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kTrue * Pose2(0.9, 0.0, 0.0), 1), Odometry(4));
+  const RelocalizationUpdate update =
+      filter.Update(AnswerOfQuery(kTrue * Pose2(-0.2, 0.0, 0.0), 1), Odometry(8));
+  EXPECT_FALSE(update.self_contradicted);
+  ASSERT_EQ(filter.Beliefs().size(), 1U);
+  EXPECT_NEAR(filter.Beliefs().front().x, (kTrue * Pose2(-0.2, 0.0, 0.0)).x, 1e-9);
+}
+
+// An accepted answer older than window_m is not upheld: the weak answer replaces it and counts as
+// a weak look (with two more along 15 m, a fix).
+TEST(FixFilter, AForgottenAcceptedAnswerIsNotUpheld) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  filter.Update(WeakAnswer(kTrue, 1), Odometry(100));  // 25 m on
+  EXPECT_FALSE(filter.Update(WeakAnswer(kTrue, 2), Odometry(140)).new_fix);
+  EXPECT_TRUE(filter.Update(WeakAnswer(kTrue, 3), Odometry(160)).new_fix);
+}
+
+// An ambiguous answer does not uphold its query's accepted one, even with a weak pose that agrees:
+// that weak answer replaces it, so one more weak answer of another query is no fix.
+TEST(FixFilter, AnAmbiguousAnswerDoesNotUpholdTheQuerysAcceptedOne) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  LocalizationResult ambiguous = WeakAnswer(kTrue, 1);
+  ambiguous.ambiguous = true;
+  filter.Update(ambiguous, Odometry(20));
+  EXPECT_FALSE(filter.Update(WeakAnswer(kTrue, 2), Odometry(40)).new_fix);
+}
+
+// No weak answer because two distinct weak candidates tie is a look-alike, not silence.
+TEST(FixFilter, ATieOfWeakCandidatesWithdrawsTheQuerysAnswer) {
+  FixFilter filter;
+  filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));
+  LocalizationResult look_alike = SilentAnswerOfQuery(1);
+  look_alike.match.weak_ambiguous = true;
+  filter.Update(look_alike, Odometry(4));
+  EXPECT_TRUE(filter.Beliefs().empty());
+}
+
 TEST(FixFilter, AQuerysWeakAnswerThatDisagreesWithItsAcceptedOneReplacesIt) {
   FixFilter filter;
   filter.Update(AnswerOfQuery(kTrue, 1), Odometry(0));

@@ -22,7 +22,7 @@ FIGURES = [
     "wrong_fix_confidence_max", "distance_to_fix_median_m", "distance_to_fix_p90_m",
     "scans_to_fix_median", "distance_after_revisit_median_m", "distance_after_revisit_p90_m",
     "lost_signals", "lost_on_correct_track", "lost_on_wrong_track", "query_log_is_map_log",
-    "exclude_shared_scans", "give_up_m", "follow_m", "pose_source"]
+    "exclude_shared_scans", "give_up_m", "follow_m", "revisit_room_m", "pose_source"]
 
 
 class RelocalizationTest(unittest.TestCase):

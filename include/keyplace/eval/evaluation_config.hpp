@@ -31,7 +31,7 @@ struct EvaluationConfig {
   // first scan the map has seen (before give_up_m or the log's end) is at least this long. Its
   // fixed fraction is reported beside the plain one: a start that meets the map a few metres
   // before it stops has no fair chance. 10 m is the path a fix of weak answers alone needs
-  // (FixPolicy::weak_fix_span_m).
+  // (FixPolicy::weak_fix_span_m, a separate setting: change both together).
   double revisit_room_m = 10.0;
   // keyplace slam --grid with --truth: an occupied cell agrees with the reference grid when an
   // occupied reference cell lies within this (two cells of the default grid).

@@ -43,7 +43,7 @@ struct RelocalizationOptions {
 };
 
 /// The benchmark's options for `starts` starts from the evaluation settings (give_up_m, follow_m,
-/// the revisit radius and angle, truth_max_gap_scans), as `keyplace relocalize` runs it: map
+/// the revisit radius, angle and room, truth_max_gap_scans), as `keyplace relocalize` runs it: map
 /// submaps sharing a scan with the query are skipped when `shared_scan_rule` is asked for and
 /// the query log is the map's own (a scan index of another recording says nothing about this
 /// one). Throws std::invalid_argument when starts < 1.

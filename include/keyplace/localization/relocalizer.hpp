@@ -127,9 +127,16 @@ class FixFilter {
   bool Enough(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest) const;
   // Whether two hypotheses name the same robot pose now, within the policy's tolerances.
   bool Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const;
-  // Drops the earlier answers of `answer`'s query from the pools; false when the query
-  // contradicts itself (then its answers no longer count).
-  bool OwnQueryAllows(const LocalizationResult& answer, const Pose2& T_odom_robot);
+  // What an answer does to the earlier answers of its query in the pools.
+  enum class OwnQuery {
+    kReplaces,      // they are dropped; the answer counts in their place
+    kKeepsEarlier,  // they stay; the answer adds nothing (it names nothing, or upholds them)
+    kSetAside,      // the query contradicts itself: nothing it says counts any more
+  };
+  OwnQuery JudgeOwnQuery(const LocalizationResult& answer, const Pose2& T_odom_robot);
+  // A weak answer agrees with an accepted, not forgotten answer of its query held in the pools.
+  bool UpholdsItsAcceptedAnswer(const LocalizationResult& weak_answer,
+                                const Pose2& T_odom_robot) const;
   // The hypotheses in `pool` that agree with `hypothesis` at the robot's current pose and come
   // from another query (answers of one query share its scans: their agreement proves nothing).
   std::vector<Hypothesis> Agreeing(const std::vector<Hypothesis>& pool,

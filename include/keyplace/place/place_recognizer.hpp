@@ -188,6 +188,9 @@ struct PlaceMatch {
   // As confidence, for the weak answer (its gamma, consensus and the distinct runner-up's
   // consensus in place of the score).
   double weak_confidence = 0.0;
+  // No weak answer because two distinct candidates the dense check supports tie on consensus: the
+  // query sees a place that looks like another (as `ambiguous`, for the weak answers).
+  bool weak_ambiguous = false;
 };
 
 /// Returns true for places the query must not be matched with (self-matches).
