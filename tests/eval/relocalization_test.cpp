@@ -3,10 +3,12 @@
 // and the fixed fraction over the starts with room (RelocalizationSummary::fixed_with_room).
 
 #include <cstddef>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "keyplace/eval/evaluation_config.hpp"
 #include "keyplace/eval/relocalization.hpp"
 #include "support/bundled_map.hpp"
 
@@ -43,6 +45,14 @@ TEST(RelocalizationSummary, TheFixedFractionWithRoomCountsStartsWithRoomAfterThe
   const RelocalizationSummary all = SummarizeRelocalization(records, options);
   EXPECT_EQ(all.starts_with_room, all.starts_with_revisit);
   EXPECT_DOUBLE_EQ(all.fixed_fraction_with_room, all.fixed_fraction);
+}
+
+TEST(RelocalizationOptions, TakeTheRoomFromTheEvaluationSettingsAndRefuseANegativeOne) {
+  EvaluationConfig evaluation;
+  evaluation.revisit_room_m = 4.0;
+  EXPECT_DOUBLE_EQ(RelocalizationOptionsFor(evaluation, 5, true, true).revisit_room_m, 4.0);
+  evaluation.revisit_room_m = -1.0;
+  EXPECT_THROW(Validate(evaluation), std::invalid_argument);
 }
 
 double PathMetres(const std::vector<Pose2>& poses, std::size_t from, std::size_t to) {
