@@ -131,20 +131,20 @@ class StartRun {
   // start can be fixed at all, whatever the localizer does; and the path left after it.
   void FindRevisit() {
     double travelled_m = 0.0;
+    double fed_m = 0.0;  // to the last scan a start without a fix is fed
     for (auto k = static_cast<std::size_t>(record_.start_scan); k < inputs_.log.scans.size(); ++k) {
       if (k > static_cast<std::size_t>(record_.start_scan)) {
         travelled_m += TranslationNorm(Between(inputs_.poses[k - 1], inputs_.poses[k]));
       }
       if (travelled_m > options_.give_up_m) break;
+      fed_m = travelled_m;
       if (!record_.revisit && truth_.Has(k) &&
           revisits_.IsRevisit(truth_.Pose(k), truth_.TruthScan(k))) {
         record_.revisit = true;
         record_.distance_to_revisit_m = travelled_m;
       }
-      if (record_.revisit) {
-        record_.room_after_revisit_m = travelled_m - record_.distance_to_revisit_m;
-      }
     }
+    if (record_.revisit) record_.room_after_revisit_m = fed_m - record_.distance_to_revisit_m;
   }
 
   // The scan a fix at scan k is checked at: scans fed so far, and a few ahead (odometry carries

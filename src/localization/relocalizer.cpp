@@ -132,10 +132,10 @@ RelocalizationUpdate FixFilter::Update(std::optional<LocalizationResult> answer,
   last_T_odom_robot_ = T_odom_robot;
 
   RelocalizationUpdate update;
-  const OwnQuery own = answer ? JudgeOwnQuery(*answer, T_odom_robot) : OwnQuery::kReplaces;
+  const OwnQuery own = answer ? JudgeOwnQuery(*answer, T_odom_robot) : OwnQuery::kKeepsEarlier;
   if (own == OwnQuery::kSetAside) {
     update.self_contradicted = true;
-  } else if (own == OwnQuery::kReplaces && answer && (answer->found || answer->weak_T_world_odom)) {
+  } else if (own == OwnQuery::kReplaces && (answer->found || answer->weak_T_world_odom)) {
     const Hypothesis hypothesis = HypothesisOf(*answer, T_odom_robot);
     if (status_ == FixStatus::kFixed) {
       Track(hypothesis, T_odom_robot, update);
@@ -360,10 +360,9 @@ FixFilter::OwnQuery FixFilter::JudgeOwnQuery(const LocalizationResult& answer,
   if (answer.query_id < 0) return OwnQuery::kReplaces;
   if (answer.query_id == self_contradicted_query_) return OwnQuery::kSetAside;
   const bool ambiguous = answer.ambiguous || answer.match.weak_ambiguous;
-  if (!answer.found && !answer.weak_T_world_odom && !ambiguous) return OwnQuery::kKeepsEarlier;
-  if (!answer.found && answer.weak_T_world_odom && !ambiguous &&
-      UpholdsItsAcceptedAnswer(answer, T_odom_robot)) {
-    return OwnQuery::kKeepsEarlier;
+  if (!answer.found && !ambiguous &&
+      (!answer.weak_T_world_odom || UpholdsItsAcceptedAnswer(answer, T_odom_robot))) {
+    return OwnQuery::kKeepsEarlier;  // silence, or a weak answer that upholds the accepted one
   }
   const Hypothesis latest{answer.T_world_odom, answer.confidence, odometry_m_, {},
                           T_odom_robot,        answer.query_id};
