@@ -99,7 +99,11 @@ GlobalLocalizer::GlobalLocalizer(std::vector<Place> places, const MappingConfig&
                                  const LocalizerConfig& config, const FlirtConfig& features)
     : config_(config),
       mapping_config_(mapping),
-      recognizer_(std::make_shared<const PlaceRecognizer>(std::move(places), config.place)),
+      recognizer_(std::make_shared<const PlaceRecognizer>(
+          std::move(places), config.place,
+          config.place.retrieval == PlaceRecognitionConfig::Retrieval::kAuto
+              ? PlaceRecognizer::Words::kAlso
+              : PlaceRecognizer::Words::kAsRetrieval)),
       extractor_(std::make_shared<const FlirtExtractor>(features)),
       builder_(mapping) {
   Validate(config_);
@@ -161,14 +165,22 @@ void GlobalLocalizer::Reset() {
 LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
   PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
+  // Holding a fix, an answer confirms it or contradicts it: the places near the fix and those
+  // most like the query suffice (issue 30: on fr079-gmapping 0.92 of the updates were tracking,
+  // at 12 ms each pairing all 529 places). Searching, a missed place is a lost answer.
+  const PlaceRecognitionConfig::Retrieval retrieval = config_.place.retrieval;
+  query.by_words = tracking_ && retrieval == PlaceRecognitionConfig::Retrieval::kAuto;
+  const bool by_words = query.by_words || retrieval == PlaceRecognitionConfig::Retrieval::kWords;
   // The words may leave out the place that would confirm a belief. Searched around the latest
   // scan, where the robot is, as a query may span 300 scans.
   const std::vector<Place>& places = recognizer_->places();
-  for (const Pose2& T_world_odom : beliefs_) {
-    const std::vector<int> near = PlaceIdsToAlsoSearch(
-        config_.place, places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
-        config_.search_near_m);
-    query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
+  if (by_words && config_.search_near_m > 0.0) {
+    for (const Pose2& T_world_odom : beliefs_) {
+      const std::vector<int> near = PlaceIdsNear(
+          places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
+          config_.search_near_m, static_cast<std::size_t>(config_.place.retrieval_places));
+      query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
+    }
   }
   std::vector<int> scan_ids = builder_.scan_ids();
   PlaceExclusion exclude;

@@ -37,7 +37,7 @@ Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
   RememberForTrackCheck(scan, T_odom_robot, -1);
-  localizer_.set_beliefs(filter_.Beliefs());
+  localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
   RelocalizationUpdate update =
       filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
   CheckTrack(T_odom_robot, update);
@@ -47,7 +47,7 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
   RememberForTrackCheck(scan, T_odom_robot, scan_id);
-  localizer_.set_beliefs(filter_.Beliefs());
+  localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
   RelocalizationUpdate update = filter_.Update(
       localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id), T_odom_robot);
   CheckTrack(T_odom_robot, update);

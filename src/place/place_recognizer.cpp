@@ -325,8 +325,12 @@ int CountConsensus(const std::vector<std::pair<int, int>>& inliers,
   return static_cast<int>(std::unique(references.begin(), references.end()) - references.begin());
 }
 
-PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config)
-    : places_(std::move(places)), config_(config) {
+PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config,
+                                 Words words)
+    : places_(std::move(places)),
+      config_(config),
+      learns_words_(words == Words::kAlso ||
+                    config.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
   Validate(config_);
   for (const Place& place : places_) {
     if (place.positions.size() != place.descriptors.size()) {
@@ -341,13 +345,13 @@ PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecogniti
 PlaceRecognizer::~PlaceRecognizer() = default;
 
 void PlaceRecognizer::RebuildWords() {
-  if (config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
+  if (learns_words_) {
     words_ = std::make_shared<PlaceWords>(places_);  // built first: a throw keeps the old
   }
 }
 
 void PlaceRecognizer::AddWordsOfLastPlace() {
-  if (!words_) return;  // retrieval exact
+  if (!words_) return;  // no words learned
   std::size_t keypoints = 0;
   for (const Place& place : places_) keypoints += place.descriptors.size();
   // Learning anew once the map holds twice the keypoints the vocabulary was learned from costs

@@ -623,6 +623,13 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
     throw std::invalid_argument("PlaceQuery: all_positions and all_descriptors differ in size");
   }
   CheckThresholds(thresholds);
+  if (query.by_words && !words_) {
+    throw std::invalid_argument(
+        "PlaceQuery.by_words: this recognizer learned no words (PlaceRecognizer::Words::kAlso)");
+  }
+  // Retrieval by the words for every query (kWords) or for those that ask (kAuto, kExact).
+  const bool by_words =
+      config_.retrieval == PlaceRecognitionConfig::Retrieval::kWords || query.by_words;
   std::vector<PlaceMatch> matches(thresholds.size());
   if (thresholds.empty()) return matches;
   const MatchKeypoints keypoints = QueryMatchKeypoints(query, config_);
@@ -641,7 +648,8 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   Pairing pairing;
   if (keypoints.positions.size() >= lowest_pairs) {
     pairing = PairWithPlaces(places_, index_.get(), slots_, config_, keypoints.descriptors,
-                             query.also_search_ids, lowest_pairs, exclude, words_.get());
+                             query.also_search_ids, lowest_pairs, exclude,
+                             by_words ? words_.get() : nullptr);
   }
   std::vector<int> rigid_star(places_.size(), -1);
   std::vector<std::vector<int>> orders(thresholds.size());

@@ -137,6 +137,45 @@ TEST(GlobalLocalizer, BeliefsMakeTheQueriesAlsoPairThePlacesNearThem) {
   EXPECT_EQ(right_answers({Pose2(500.0, 500.0, 0.0)}), words_alone);
 }
 
+// With retrieval `auto` a query pairs every place while the caller searches, and the places the
+// words retrieve and those near the beliefs while it tracks a fix (set_beliefs, tracking): each
+// answer of the bundled log is that of a localizer of retrieval exact, or words, with the same
+// beliefs (place id, candidates, consensus, pose). The first third of the log, every second scan.
+TEST(GlobalLocalizer, WithRetrievalAutoATrackingQueryIsAnsweredByTheWordsASearchingOneByAll) {
+  const Bundled& b = BundledLog();
+  const auto answers = [&](PlaceRecognitionConfig::Retrieval retrieval, bool tracking) {
+    LocalizerConfig config;
+    config.query_every_m = 0.0;
+    config.place.retrieval = retrieval;
+    config.place.retrieval_places = 5;
+    GlobalLocalizer localizer(b.map, config);
+    localizer.set_exclusion([](const Place& place, const std::vector<int>& query_scans) {
+      return IsSelfMatch(SelfMatchRule::kSameScans, SortedScans(query_scans), place.scan_indices);
+    });
+    localizer.set_beliefs({Pose2(0.5, -0.5, 0.02)}, tracking);
+    std::vector<std::vector<double>> fields;
+    for (std::size_t k = 0; k < b.inputs.log.scans.size() / 3; k += 2) {
+      const std::optional<LocalizationResult> answer = localizer.AddScan(
+          b.inputs.log.scans[k], b.inputs.poses[k], b.inputs.keypoints[k], static_cast<int>(k));
+      if (!answer) continue;
+      const PlaceMatch& m = answer->match;
+      fields.push_back({static_cast<double>(m.place_id), static_cast<double>(m.candidates),
+                        static_cast<double>(m.consensus), m.estimated_pose.x, m.estimated_pose.y,
+                        m.estimated_pose.theta});
+    }
+    return fields;
+  };
+  using Retrieval = PlaceRecognitionConfig::Retrieval;
+  const auto tracking = answers(Retrieval::kAuto, true);
+  const auto searching = answers(Retrieval::kAuto, false);
+  ASSERT_GT(tracking.size(), 30u) << tracking.size();
+  EXPECT_EQ(tracking, answers(Retrieval::kWords, true));
+  EXPECT_EQ(searching, answers(Retrieval::kExact, false));
+  EXPECT_NE(tracking, searching);
+  // An exact localizer pairs every place whether it tracks or not.
+  EXPECT_EQ(answers(Retrieval::kExact, true), searching);
+}
+
 std::size_t ResidentKiB() {
   std::ifstream statm("/proc/self/statm");
   std::size_t size_pages = 0;

@@ -4,6 +4,7 @@
 
 #include "keyplace/localization/log_relocalization.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "keyplace/config/config.hpp"
+#include "keyplace/localization/relocalizer.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "support/bundled_map.hpp"
 #include "support/expect_contains.hpp"
@@ -116,6 +118,34 @@ TEST(RelocalizeLog, AnswersHeldMakeTheQueriesAlsoPairThePlacesTheyPointTo) {
   const std::size_t words_alone = fixed_scans(0.0);
   // Measured: 512 scans fixed with the words alone, 538 with the places near the answers.
   EXPECT_GT(fixed_scans(3.0), words_alone + 10) << "words alone " << words_alone;
+}
+
+// With retrieval `auto` (the default) the Relocalizer's queries pair every place while it searches
+// and, once it holds a fix, only the places the words retrieve and those near its beliefs (the
+// fix and the answers that challenge it, place.retrieval_places each); the fix holds as well.
+TEST(RelocalizeLog, HoldingAFixTheQueriesPairTheRetrievedPlacesOnly) {
+  const GlobalMap map = FirstHalfMap();
+  const LogInputs inputs = SecondHalfWithoutTruth();
+  LocalizerConfig config = ToLocalizerConfig(PresetConfig("strict"));
+  ASSERT_EQ(config.place.retrieval, PlaceRecognitionConfig::Retrieval::kAuto);
+  config.place.retrieval_places = 5;
+  Relocalizer relocalizer(map, config);
+  int most_searching = 0, most_tracking = 0, tracking_answers = 0, fixed = 0;
+  for (std::size_t k = 0; k < inputs.log.scans.size(); ++k) {
+    const bool tracking = relocalizer.status() == FixStatus::kFixed;
+    const RelocalizationUpdate update = relocalizer.AddScan(
+        inputs.log.scans[k], inputs.poses[k], inputs.keypoints[k], static_cast<int>(k));
+    fixed += update.status == FixStatus::kFixed;
+    if (!update.answer) continue;
+    int& most = tracking ? most_tracking : most_searching;
+    most = std::max(most, update.answer->match.candidates);
+    tracking_answers += tracking;
+  }
+  EXPECT_GT(tracking_answers, 20);
+  // Measured: at most 10 candidates while tracking, 122 while searching.
+  EXPECT_LE(most_tracking, 15);  // the words' 5 and 5 near each of at most two beliefs
+  EXPECT_GT(most_searching, 15);
+  EXPECT_GT(fixed, static_cast<int>(inputs.log.scans.size()) / 2);
 }
 
 TEST(RelocalizeLog, InputsWithoutAPosePerScanAreRefusedNamingTheLog) {

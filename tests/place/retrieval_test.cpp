@@ -282,6 +282,35 @@ TEST(Retrieval, PlacesNearTheQueryAlsoSearchedBringBackItsAnswers) {
   ExpectNearlyAsManyRightAnswers(near, exact, 0.9);
 }
 
+// A recognizer of retrieval exact that also learned the words (the Relocalizer's, retrieval auto)
+// answers a query that asks for them (PlaceQuery::by_words) as a recognizer of retrieval words,
+// and any other query as the exact path, field for field; one that learned no words refuses it.
+TEST(Retrieval, AQueryByWordsIsAnsweredAsByTheWordsAndAnyOtherAsByTheExactPath) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
+  const PlaceRecognizer both(places, ExactConfig(), PlaceRecognizer::Words::kAlso);
+  const std::vector<LocalizationRecord> exact =
+      EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
+  ExpectSameAnswers(EvaluateQueries(queries, both, SelfMatchRule::kSameScans), exact);
+
+  for (LocalizationQuery& query : queries) query.query.by_words = true;
+  const std::vector<LocalizationRecord> by_words =
+      EvaluateQueries(queries, both, SelfMatchRule::kSameScans);
+  const std::vector<LocalizationRecord> words =
+      EvaluateQueries(queries, PlaceRecognizer(places, WordsConfig(50)), SelfMatchRule::kSameScans);
+  ExpectSameAnswers(by_words, words);
+  for (const LocalizationRecord& record : by_words) EXPECT_LE(record.match.candidates, 50);
+  const auto most_candidates = [](const std::vector<LocalizationRecord>& records) {
+    int most = 0;
+    for (const LocalizationRecord& record : records) most = std::max(most, record.match.candidates);
+    return most;
+  };
+  EXPECT_GT(most_candidates(exact), 50);  // else the words would retrieve nothing less
+
+  const PlaceRecognizer exact_only(places, ExactConfig());
+  EXPECT_THROW(exact_only.Recognize(queries.front().query), std::invalid_argument);
+}
+
 TEST(PlaceIdsNear, NearestFirstWithinTheRadiusAmongTheCandidates) {
   std::vector<Place> places(5);
   const double x_m[] = {4.0, 1.0, 3.0, 0.5, 1.0};

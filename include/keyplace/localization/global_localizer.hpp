@@ -83,10 +83,11 @@ struct LocalizerConfig {
   // robot has now, where submaps take long to complete (scans far apart, open halls). The query
   // keeps growing; completion resets it.
   double query_every_m = 1.0;
-  // With retrieval `words`, a query also pairs the places whose origin lies within this of where
-  // a belief of the caller puts the robot (GlobalLocalizer::set_beliefs: the Relocalizer's
-  // pending answers and its fix), at most place.retrieval_places per belief, whatever their words
-  // rank: an answer that would confirm a belief is not left to the words. 0: the words alone.
+  // With retrieval `words` (or `auto` while tracking a fix), a query also pairs the places whose
+  // origin lies within this of where a belief of the caller puts the robot
+  // (GlobalLocalizer::set_beliefs: the Relocalizer's pending answers and its fix), at most
+  // place.retrieval_places per belief, whatever their words rank: an answer that would confirm a
+  // belief is not left to the words. 0: the words alone.
   double search_near_m = 3.0;
   FixPolicy fix;  // the Relocalizer's
 };
@@ -153,8 +154,14 @@ class GlobalLocalizer {
 
   void set_exclusion(QueryExclusion exclusion) { exclusion_ = std::move(exclusion); }
   /// Where the caller believes the odometry frame lies in the map (map <- odometry, one per
-  /// belief; LocalizerConfig::search_near_m). Kept until set again.
-  void set_beliefs(std::vector<Pose2> T_world_odom) { beliefs_ = std::move(T_world_odom); }
+  /// belief; LocalizerConfig::search_near_m), and whether one of them is a fix the answers only
+  /// confirm or contradict (`tracking`): with place.retrieval `auto` a tracking query pairs the
+  /// places the words retrieve and those near the beliefs, a searching one every place. Kept
+  /// until set again.
+  void set_beliefs(std::vector<Pose2> T_world_odom, bool tracking = false) {
+    beliefs_ = std::move(T_world_odom);
+    tracking_ = tracking;
+  }
   const QueryExclusion& exclusion() const { return exclusion_; }
 
   std::size_t buffered_scans() const { return builder_.size(); }
@@ -178,6 +185,7 @@ class GlobalLocalizer {
   long long query_id_ = 0;  // counts the queries begun
   QueryExclusion exclusion_;
   std::vector<Pose2> beliefs_;  // T_world_odom
+  bool tracking_ = false;
 };
 
 /// One scan against single-scan places (the TIP-FLIRT baseline: every scan of a log is a

@@ -40,9 +40,11 @@ struct PlaceRecognitionConfig {
   // Which places a query is paired with. kExact: every place (the oracle). kWords: the
   // retrieval_places places whose word histograms (a vocabulary of descriptors learned from the
   // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval"). kAuto:
-  // kWords for SLAM's loop queries (a loop one submap's query misses, the next submaps' find),
-  // kExact wherever else (PlaceRecognizer takes kAuto as kExact): a single query's miss is a lost
-  // answer, and the Relocalizer fixed fewer starts with kWords (docs/notes/retrieval.md).
+  // kWords for SLAM's loop queries (a loop one submap's query misses, the next submaps' find) and
+  // for the Relocalizer's queries while it holds a fix (they confirm or contradict it; the places
+  // near the fix are paired too), kExact wherever else (PlaceRecognizer takes kAuto as kExact): a
+  // searching query's miss is a lost answer, and the Relocalizer fixed fewer starts with kWords
+  // (docs/notes/retrieval.md).
   enum class Retrieval { kAuto, kExact, kWords };
   Retrieval retrieval = Retrieval::kAuto;
   int retrieval_places = 50;

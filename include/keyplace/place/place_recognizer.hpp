@@ -70,6 +70,10 @@ struct PlaceQuery {
   // and fix). `exact` pairs every place anyway; an id the map does not hold, or an excluded place,
   // is not searched.
   std::vector<int> also_search_ids;
+  // Pair only the places the words retrieve (and also_search_ids), whatever the recognizer's
+  // retrieval: the Relocalizer's queries once it holds a fix (PlaceRecognitionConfig::kAuto).
+  // Needs a recognizer that learned the words (retrieval words, or PlaceRecognizer::Words::kAlso).
+  bool by_words = false;
 };
 
 /// Greedy merge: keeps each keypoint unless one already kept lies within `radius_m` (input order
@@ -209,8 +213,13 @@ class PlaceWords;           // place/place_words.hpp (internal)
 
 class PlaceRecognizer {
  public:
+  /// Whether the recognizer learns the words of its places: as its retrieval needs them, or also
+  /// with retrieval exact or auto, for the queries that ask for them (PlaceQuery::by_words).
+  enum class Words { kAsRetrieval, kAlso };
+
   /// Throws std::invalid_argument (Validate) for an invalid config.
-  PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config);
+  PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config,
+                  Words words = Words::kAsRetrieval);
   // Copies share the index until one of them adds or removes a place (it then indexes its own).
   PlaceRecognizer(const PlaceRecognizer&) = default;
   PlaceRecognizer& operator=(const PlaceRecognizer&) = default;
@@ -241,7 +250,8 @@ class PlaceRecognizer {
   /// thread only, but how often depends on the threads (neighbours of candidates verified ahead
   /// in a wave), so it must be a pure predicate. With `first_verified` a wave verifies as many
   /// candidates as there are threads, also when queries already run in parallel, so up to
-  /// threads - 1 RANSACs past the first verified one run and are not counted.
+  /// threads - 1 RANSACs past the first verified one run and are not counted. Throws
+  /// std::invalid_argument for a query by_words to a recognizer without words.
   PlaceMatch Recognize(const PlaceQuery& query, const PlaceExclusion& exclude = {}) const;
 
   /// Recognize under each of `thresholds` (this recognizer's config with min_pairs, min_gamma and
@@ -263,7 +273,8 @@ class PlaceRecognizer {
   // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for
   // descriptor_index none or retrieval words (the retrieved places get one per query).
   void RebuildIndex();
-  // The vocabulary and word histograms of places_ (retrieval kWords), learned anew.
+  // The vocabulary and word histograms of places_ (retrieval kWords, or Words::kAlso), learned
+  // anew.
   void RebuildWords();
   // Adds places_.back() to the word histograms, learning the vocabulary anew when due.
   void AddWordsOfLastPlace();
@@ -273,7 +284,8 @@ class PlaceRecognizer {
   std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none or words
   std::vector<std::size_t> slots_;              // index place number of each of places_
   std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
-  std::shared_ptr<PlaceWords> words_;           // null unless retrieval words
+  bool learns_words_ = false;                   // retrieval words, or Words::kAlso
+  std::shared_ptr<PlaceWords> words_;           // null unless learns_words_
 };
 
 }  // namespace keyplace
