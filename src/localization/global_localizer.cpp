@@ -102,8 +102,8 @@ GlobalLocalizer::GlobalLocalizer(std::vector<Place> places, const MappingConfig&
       recognizer_(std::make_shared<const PlaceRecognizer>(
           std::move(places), config.place,
           config.place.retrieval == PlaceRecognitionConfig::Retrieval::kAuto
-              ? PlaceRecognizer::Words::kAlso
-              : PlaceRecognizer::Words::kAsRetrieval)),
+              ? PlaceRecognizer::LearnWords::kAlways
+              : PlaceRecognizer::LearnWords::kForRetrievalWords)),
       extractor_(std::make_shared<const FlirtExtractor>(features)),
       builder_(mapping) {
   Validate(config_);
@@ -166,15 +166,15 @@ LocalizationResult GlobalLocalizer::Localize() const {
   const std::size_t latest = builder_.size() - 1;
   PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
   // Holding a fix, an answer confirms it or contradicts it: the places near the fix and those
-  // most like the query suffice (issue 30: on fr079-gmapping 0.92 of the updates were tracking,
+  // most like the query suffice (issue 30: on fr079-gmapping 0.91 of the updates were tracking,
   // at 12 ms each pairing all 529 places). Searching, a missed place is a lost answer.
   const PlaceRecognitionConfig::Retrieval retrieval = config_.place.retrieval;
   query.by_words = tracking_ && retrieval == PlaceRecognitionConfig::Retrieval::kAuto;
-  const bool by_words = query.by_words || retrieval == PlaceRecognitionConfig::Retrieval::kWords;
+  const bool retrieves = query.by_words || retrieval == PlaceRecognitionConfig::Retrieval::kWords;
   // The words may leave out the place that would confirm a belief. Searched around the latest
   // scan, where the robot is, as a query may span 300 scans.
   const std::vector<Place>& places = recognizer_->places();
-  if (by_words && config_.search_near_m > 0.0) {
+  if (retrieves && config_.search_near_m > 0.0) {
     for (const Pose2& T_world_odom : beliefs_) {
       const std::vector<int> near = PlaceIdsNear(
           places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),

@@ -53,8 +53,8 @@ const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
                 "also answer from the query as it stands every time the robot travelled this far "
                 "(0 = only complete queries)")
         .Double("search_near_m", &C::search_near_m, "m",
-                "retrieval words: queries also pair the places this close to where a pending "
-                "answer or the fix puts the robot (0 = words alone)")
+                "retrieval words, or auto while a fix is held: queries also pair the places this "
+                "close to where a pending answer or the fix puts the robot (0 = words alone)")
         .Nested("fix", &C::fix, FixPolicyFields());
     return table;
   }();

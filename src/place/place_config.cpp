@@ -73,7 +73,8 @@ const ConfigFields<PlaceRecognitionConfig>& PlaceConfigFields() {
               "places paired with a query: every one (exact), the retrieval_places most similar "
               "by a vocabulary of descriptors learned from the map (words), or words for SLAM's "
               "loop queries and the relocalizer's once it holds a fix, exact elsewhere (auto)")
-        .Int("retrieval_places", &C::retrieval_places, "", "words: places paired with a query")
+        .Int("retrieval_places", &C::retrieval_places, "",
+             "words (and auto where it retrieves): places paired with a query")
         .Enum("query_keypoints", &C::query_keypoints,
               {{C::QueryKeypoints::kStable, "stable"}, {C::QueryKeypoints::kAllScans, "all_scans"}},
               "query keypoints paired and verified: the submap's stable ones or all its scans'")

@@ -326,10 +326,10 @@ int CountConsensus(const std::vector<std::pair<int, int>>& inliers,
 }
 
 PlaceRecognizer::PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config,
-                                 Words words)
+                                 LearnWords learn_words)
     : places_(std::move(places)),
       config_(config),
-      learns_words_(words == Words::kAlso ||
+      learns_words_(learn_words == LearnWords::kAlways ||
                     config.retrieval == PlaceRecognitionConfig::Retrieval::kWords) {
   Validate(config_);
   for (const Place& place : places_) {

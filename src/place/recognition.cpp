@@ -625,7 +625,8 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   CheckThresholds(thresholds);
   if (query.by_words && !words_) {
     throw std::invalid_argument(
-        "PlaceQuery.by_words: this recognizer learned no words (PlaceRecognizer::Words::kAlso)");
+        "PlaceQuery.by_words: this recognizer learned no words "
+        "(PlaceRecognizer::LearnWords::kAlways)");
   }
   // Retrieval by the words for every query (kWords) or for those that ask (kAuto, kExact).
   const bool by_words =

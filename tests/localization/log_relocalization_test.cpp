@@ -143,7 +143,7 @@ TEST(RelocalizeLog, HoldingAFixTheQueriesPairTheRetrievedPlacesOnly) {
   }
   EXPECT_GT(tracking_answers, 20);
   // Measured: at most 10 candidates while tracking, 122 while searching.
-  EXPECT_LE(most_tracking, 15);  // the words' 5 and 5 near each of at most two beliefs
+  EXPECT_LE(most_tracking, 15);  // the words' 5 and 5 near each belief: a margin over 10
   EXPECT_GT(most_searching, 15);
   EXPECT_GT(fixed, static_cast<int>(inputs.log.scans.size()) / 2);
 }

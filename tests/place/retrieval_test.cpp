@@ -288,7 +288,7 @@ TEST(Retrieval, PlacesNearTheQueryAlsoSearchedBringBackItsAnswers) {
 TEST(Retrieval, AQueryByWordsIsAnsweredAsByTheWordsAndAnyOtherAsByTheExactPath) {
   const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
   std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(25);
-  const PlaceRecognizer both(places, ExactConfig(), PlaceRecognizer::Words::kAlso);
+  const PlaceRecognizer both(places, ExactConfig(), PlaceRecognizer::LearnWords::kAlways);
   const std::vector<LocalizationRecord> exact =
       EvaluateQueries(queries, PlaceRecognizer(places, ExactConfig()), SelfMatchRule::kSameScans);
   ExpectSameAnswers(EvaluateQueries(queries, both, SelfMatchRule::kSameScans), exact);

@@ -42,9 +42,9 @@ struct PlaceRecognitionConfig {
   // map, tf-idf weighted) are most similar to the query's (docs/PLACE.md, "Retrieval"). kAuto:
   // kWords for SLAM's loop queries (a loop one submap's query misses, the next submaps' find) and
   // for the Relocalizer's queries while it holds a fix (they confirm or contradict it; the places
-  // near the fix are paired too), kExact wherever else (PlaceRecognizer takes kAuto as kExact): a
-  // searching query's miss is a lost answer, and the Relocalizer fixed fewer starts with kWords
-  // (docs/notes/retrieval.md).
+  // near the fix are paired too), kExact wherever else (PlaceRecognizer takes kAuto as kExact but
+  // for a query that asks for the words, PlaceQuery::by_words): a searching query's miss is a
+  // lost answer, and the Relocalizer fixed fewer starts with kWords (docs/notes/retrieval.md).
   enum class Retrieval { kAuto, kExact, kWords };
   Retrieval retrieval = Retrieval::kAuto;
   int retrieval_places = 50;

@@ -65,14 +65,14 @@ struct PlaceQuery {
   // Optional: the latest scans' beams in the same frame, for the dense check
   // (PlaceRecognitionConfig::dense_min_hit_fraction). Empty: keypoints alone decide.
   std::vector<QueryScanPoints> scans;
-  // Optional, with retrieval `words`: ids of places paired whatever their words rank (those near
-  // where the caller already believes the query lies: SLAM's estimate, the Relocalizer's answers
-  // and fix). `exact` pairs every place anyway; an id the map does not hold, or an excluded place,
-  // is not searched.
+  // Optional, with retrieval `words` or by_words: ids of places paired whatever their words rank
+  // (those near where the caller already believes the query lies: SLAM's estimate, the
+  // Relocalizer's answers and fix). `exact` pairs every place anyway; an id the map does not hold,
+  // or an excluded place, is not searched.
   std::vector<int> also_search_ids;
   // Pair only the places the words retrieve (and also_search_ids), whatever the recognizer's
   // retrieval: the Relocalizer's queries once it holds a fix (PlaceRecognitionConfig::kAuto).
-  // Needs a recognizer that learned the words (retrieval words, or PlaceRecognizer::Words::kAlso).
+  // Needs a recognizer that learned the words (retrieval words, or LearnWords::kAlways).
   bool by_words = false;
 };
 
@@ -213,13 +213,13 @@ class PlaceWords;           // place/place_words.hpp (internal)
 
 class PlaceRecognizer {
  public:
-  /// Whether the recognizer learns the words of its places: as its retrieval needs them, or also
-  /// with retrieval exact or auto, for the queries that ask for them (PlaceQuery::by_words).
-  enum class Words { kAsRetrieval, kAlso };
+  /// When the recognizer learns the words of its places: only when its retrieval is `words`, or
+  /// always, for the queries that ask for them whatever the retrieval (PlaceQuery::by_words).
+  enum class LearnWords { kForRetrievalWords, kAlways };
 
   /// Throws std::invalid_argument (Validate) for an invalid config.
   PlaceRecognizer(std::vector<Place> places, const PlaceRecognitionConfig& config,
-                  Words words = Words::kAsRetrieval);
+                  LearnWords learn_words = LearnWords::kForRetrievalWords);
   // Copies share the index until one of them adds or removes a place (it then indexes its own).
   PlaceRecognizer(const PlaceRecognizer&) = default;
   PlaceRecognizer& operator=(const PlaceRecognizer&) = default;
@@ -229,9 +229,10 @@ class PlaceRecognizer {
 
   /// Appends a place (last in places()) and indexes its descriptors without rebuilding the index:
   /// with retrieval exact every answer is then the one of a recognizer constructed from places()
-  /// at once. With retrieval kWords the place is described with the vocabulary held, which is
-  /// learned anew from places() (answers as at once) when they hold twice the keypoints it was
-  /// learned from; in between, answers may differ from those of a recognizer built at once.
+  /// at once. With words learned (retrieval kWords, LearnWords::kAlways) the place is described
+  /// with the vocabulary held, which is learned anew from places() (answers as at once) when they
+  /// hold twice the keypoints it was learned from; in between, retrieval's answers may differ
+  /// from those of a recognizer built at once.
   /// Throws std::invalid_argument when its positions and descriptors differ in size.
   void AddPlace(Place place);
   /// Removes the first place with this id (later places move up one index); every answer is then
@@ -273,8 +274,7 @@ class PlaceRecognizer {
   // A new index over places_ (slots 0..n-1), forgetting removed keypoints; none for
   // descriptor_index none or retrieval words (the retrieved places get one per query).
   void RebuildIndex();
-  // The vocabulary and word histograms of places_ (retrieval kWords, or Words::kAlso), learned
-  // anew.
+  // The vocabulary and word histograms of places_ (learns_words_), learned anew.
   void RebuildWords();
   // Adds places_.back() to the word histograms, learning the vocabulary anew when due.
   void AddWordsOfLastPlace();
@@ -284,7 +284,7 @@ class PlaceRecognizer {
   std::shared_ptr<SqrtDescriptorIndex> index_;  // null for descriptor_index none or words
   std::vector<std::size_t> slots_;              // index place number of each of places_
   std::size_t removed_keypoints_ = 0;           // still in index_, of removed places
-  bool learns_words_ = false;                   // retrieval words, or Words::kAlso
+  bool learns_words_ = false;                   // retrieval words, or LearnWords::kAlways
   std::shared_ptr<PlaceWords> words_;           // null unless learns_words_
 };
 
