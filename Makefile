@@ -21,11 +21,11 @@ FUZZ_SEED ?= 1
 SANITIZE_ENV := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:allocator_may_return_null=1:check_initialization_order=1 \
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0
-# Not run under the sanitizers, for time only (docs/RELIABILITY.md, Sanitizers): the whole-log
-# comparisons of one answer against another way of computing it (oracles, thread counts,
-# thresholds, the place database, all-scan loop queries, keypoints given or extracted, loop
-# queries with and without the submaps nearby, tracking queries against words and exact;
-# 28-310 s each sanitized) and the whole-log bag map. The library code they run runs sanitized in the smaller tests of the same
+# Not run under the sanitizers, for time only (docs/RELIABILITY.md, Sanitizers): comparisons of
+# one answer against another way of computing it (oracles, thread counts, thresholds, the place
+# database, all-scan loop queries, keypoints given or extracted, loop queries with and without
+# the submaps nearby, tracking queries against words and exact; 28-310 s each sanitized) and the
+# whole-log bag map. The library code they run runs sanitized in the smaller tests of the same
 # classes.
 SANITIZE_SKIP_TESTS := GlobalLocalizer.StreamingGivesTheBatchAnswerOnEverySecondQueryOfTheBundledLog \
   DescriptorIndex.SameAnswerAsExhaustiveOnEverySecondQueryOfTheBundledLog \
