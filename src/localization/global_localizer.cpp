@@ -133,7 +133,7 @@ std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan
   }
   last_T_odom_robot_ = T_odom_robot;
   if (complete || static_cast<int>(builder_.size()) >= config_.max_query_scans) {
-    LocalizationResult result = Localize();
+    LocalizationResult result = Localize(&pair_memo_);
     Reset();
     return result;
   }
@@ -144,14 +144,14 @@ std::optional<LocalizationResult> GlobalLocalizer::AddScan(const LaserScan& scan
       std::max(config_.query_every_m, 0.5 * (query_path_m_ - path_since_answer_m_));
   if (config_.query_every_m > 0.0 && path_since_answer_m_ >= next_answer_m) {
     path_since_answer_m_ = 0.0;
-    return Localize();
+    return Localize(&pair_memo_);
   }
   return std::nullopt;
 }
 
 std::optional<LocalizationResult> GlobalLocalizer::LocalizeNow() const {
   if (builder_.empty()) return std::nullopt;
-  return Localize();
+  return Localize(nullptr);
 }
 
 void GlobalLocalizer::Reset() {
@@ -159,10 +159,11 @@ void GlobalLocalizer::Reset() {
   path_since_answer_m_ = 0.0;
   query_path_m_ = 0.0;
   last_T_odom_robot_.reset();
+  pair_memo_.Clear();  // the next query's scans are new
   ++query_id_;
 }
 
-LocalizationResult GlobalLocalizer::Localize() const {
+LocalizationResult GlobalLocalizer::Localize(PairMemo* memo) const {
   const std::size_t latest = builder_.size() - 1;
   PlaceQuery query = builder_.Query(latest, config_.place.query_keypoints);
   // Holding a fix, an answer confirms it or contradicts it: the places near the fix and those
@@ -182,6 +183,7 @@ LocalizationResult GlobalLocalizer::Localize() const {
       query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
     }
   }
+  query.pair_memo = memo;
   std::vector<int> scan_ids = builder_.scan_ids();
   PlaceExclusion exclude;
   if (exclusion_) {

@@ -1,6 +1,7 @@
 #include "place/descriptor_index.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -57,6 +58,11 @@ void FillRoots(const BetaGridDescriptor& descriptor, double* row) {
   }
 }
 
+std::uint64_t NextIndexId() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
 }  // namespace
 
 // Named, not anonymous: SqrtDescriptorIndex::KdTree, a class with external linkage, holds these.
@@ -99,7 +105,7 @@ struct SqrtDescriptorIndex::KdTree {
 
 SqrtDescriptorIndex::SqrtDescriptorIndex(const std::vector<Place>& places,
                                          PlaceRecognitionConfig::DescriptorIndex kind)
-    : kind_(kind) {
+    : kind_(kind), id_(NextIndexId()) {
   if (kind == PlaceRecognitionConfig::DescriptorIndex::kNone) {
     throw std::invalid_argument("SqrtDescriptorIndex: descriptor_index none has no index");
   }

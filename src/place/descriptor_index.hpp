@@ -5,6 +5,7 @@
 // finds the pairs exhaustive matching finds, with the same distances, in the same order.
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -37,6 +38,9 @@ class SqrtDescriptorIndex {
   std::size_t places() const { return first_of_place_.size() - 1; }
   std::size_t keypoints() const { return descriptors_.size(); }
   std::size_t trees() const;  // kKdTree: the trees searched per query (kDense: 0)
+  /// Distinct for every index made in this process (what a PairMemo's rows were computed
+  /// against).
+  std::uint64_t id() const { return id_; }
 
   /// For every place p with searched[p] != 0: below[p] = the pairs (query index, keypoint index
   /// of place p, SymmetricChi2) with SymmetricChi2Below(query, keypoint, chi2_threshold), ordered
@@ -60,6 +64,7 @@ class SqrtDescriptorIndex {
                    double chi2_threshold, DescriptorPair& pair) const;
 
   PlaceRecognitionConfig::DescriptorIndex kind_;
+  std::uint64_t id_;
   std::vector<BetaGridDescriptor> descriptors_;  // every place keypoint, place-major
   std::vector<int> place_of_;                    // place index of each keypoint
   std::vector<int> first_of_place_{0};           // each place's first keypoint, then the end

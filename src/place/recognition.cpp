@@ -26,6 +26,7 @@
 #include "keyplace/place/ransac.hpp"
 #include "place/candidate_ranking.hpp"
 #include "place/descriptor_index.hpp"
+#include "place/pair_memo.hpp"
 #include "place/place_words.hpp"
 #include "place/unique_pairs.hpp"
 
@@ -98,6 +99,7 @@ MatchKeypoints QueryMatchKeypoints(const PlaceQuery& query, const PlaceRecogniti
 struct Pairing {
   std::vector<Candidate> by_place;  // place p's unique pairs (place_index -1: < min_pairs)
   std::vector<char> excluded;       // places of >= min_pairs keypoints that `exclude` rejected
+  int descriptors_remembered = -1;  // PlaceMatch's
 };
 
 // Of the places marked in `searched`, keeps the `count` most similar to the query by their words
@@ -140,7 +142,7 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
                        const std::vector<std::size_t>& slots, const PlaceRecognitionConfig& config,
                        const std::vector<BetaGridDescriptor>& query,
                        const std::vector<int>& also_search_ids, std::size_t min_pairs,
-                       const PlaceExclusion& exclude, const PlaceWords* words) {
+                       const PlaceExclusion& exclude, const PlaceWords* words, PairMemo* memo) {
   Pairing pairing;
   pairing.by_place.resize(places.size());
   pairing.excluded.assign(places.size(), 0);
@@ -182,7 +184,13 @@ Pairing PairWithPlaces(const std::vector<Place>& places, const SqrtDescriptorInd
     for (std::size_t p = 0; p < places.size(); ++p) {
       if (searched[p]) searched_slots[slot_of[p]] = 1;
     }
-    index->FindPairs(query, config.descriptor_match_chi2, searched_slots, below);
+    if (memo && !retrieved) {
+      PairMemoAccess::FindPairs(*memo, *index, query, config.descriptor_match_chi2, searched_slots,
+                                below);
+      pairing.descriptors_remembered = static_cast<int>(memo->reused());
+    } else {
+      index->FindPairs(query, config.descriptor_match_chi2, searched_slots, below);
+    }
   }
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, places.size(), kPlacesPerTask),
@@ -650,7 +658,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   if (keypoints.positions.size() >= lowest_pairs) {
     pairing = PairWithPlaces(places_, index_.get(), slots_, config_, keypoints.descriptors,
                              query.also_search_ids, lowest_pairs, exclude,
-                             by_words ? words_.get() : nullptr);
+                             by_words ? words_.get() : nullptr, query.pair_memo);
   }
   std::vector<int> rigid_star(places_.size(), -1);
   std::vector<std::vector<int>> orders(thresholds.size());
@@ -692,6 +700,7 @@ std::vector<PlaceMatch> PlaceRecognizer::RecognizeAtThresholds(
   const double seconds_verification = SecondsSince(verify_start);
   const double seconds = SecondsSince(start);
   for (PlaceMatch& match : matches) {
+    match.descriptors_remembered = pairing.descriptors_remembered;
     match.seconds_pairing = seconds_pairing;
     match.seconds_verification = seconds_verification;
     match.seconds = seconds;

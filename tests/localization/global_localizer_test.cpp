@@ -325,6 +325,14 @@ TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
   for (std::size_t i = 0; i < answers.size(); ++i) {
     const bool last_of_query =
         i + 1 == answers.size() || answers[i + 1].query_id != answers[i].query_id;
+    // A query's later answers pair only the descriptors its earlier ones did not (PairMemo); its
+    // first pairs them all.
+    const bool first_of_query = i == 0 || answers[i].query_id != answers[i - 1].query_id;
+    if (first_of_query) {
+      EXPECT_EQ(answers[i].match.descriptors_remembered, 0) << i;
+    } else {
+      EXPECT_GT(answers[i].match.descriptors_remembered, 0) << i;
+    }
     if (i > 0 && answers[i].query_id == answers[i - 1].query_id) {
       EXPECT_GT(answers[i].scans, answers[i - 1].scans) << i;
       // Answers before completion come a metre apart, or half the query's path at the last

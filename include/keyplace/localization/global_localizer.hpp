@@ -25,6 +25,7 @@
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/localization/query_builder.hpp"
 #include "keyplace/mapping/global_map.hpp"
+#include "keyplace/place/pair_memo.hpp"
 #include "keyplace/place/place_config.hpp"
 #include "keyplace/place/place_recognizer.hpp"
 
@@ -172,7 +173,8 @@ class GlobalLocalizer {
  private:
   GlobalLocalizer(std::vector<Place> places, const MappingConfig& mapping,
                   const LocalizerConfig& config, const FlirtConfig& features);
-  LocalizationResult Localize() const;
+  // `memo`: the growing query's pairs (AddScan's; LocalizeNow, const, pairs afresh).
+  LocalizationResult Localize(PairMemo* memo) const;
 
   LocalizerConfig config_;
   MappingConfig mapping_config_;
@@ -186,6 +188,7 @@ class GlobalLocalizer {
   QueryExclusion exclusion_;
   std::vector<Pose2> beliefs_;  // T_world_odom
   bool tracking_ = false;
+  PairMemo pair_memo_;  // the pairs of the query being built, for its next answer
 };
 
 /// One scan against single-scan places (the TIP-FLIRT baseline: every scan of a log is a

@@ -19,6 +19,7 @@
 #include "keyplace/features/descriptor.hpp"
 #include "keyplace/mapping/global_map.hpp"
 #include "keyplace/place/dense_check.hpp"
+#include "keyplace/place/pair_memo.hpp"
 #include "keyplace/place/place_config.hpp"
 
 namespace keyplace {
@@ -74,6 +75,9 @@ struct PlaceQuery {
   // retrieval: the Relocalizer's queries once it holds a fix (PlaceRecognitionConfig::kAuto).
   // Needs a recognizer that learned the words (retrieval words, or LearnWords::kAlways).
   bool by_words = false;
+  // Optional: the growing query's memo of descriptor pairs (PairMemo), used and updated when the
+  // query pairs every place through the descriptor index. The answer does not depend on it.
+  PairMemo* pair_memo = nullptr;
 };
 
 /// Greedy merge: keeps each keypoint unless one already kept lies within `radius_m` (input order
@@ -178,6 +182,8 @@ struct PlaceMatch {
   int candidates_verified = 0;
   int candidates_accepted = 0;  // candidates that passed both checks
   int places_excluded = 0;      // skipped by the exclusion predicate
+  // Query descriptors whose pairs came from PlaceQuery::pair_memo (-1: the memo was not used).
+  int descriptors_remembered = -1;
   double seconds_pairing = 0.0;
   double seconds_verification = 0.0;
   double seconds = 0.0;

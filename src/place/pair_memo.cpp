@@ -1,0 +1,114 @@
+#include "place/pair_memo.hpp"
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/fnv1a64.hpp"
+
+namespace keyplace {
+
+void PairMemo::Clear() {
+  rows_.clear();
+  pairs_ = 0;
+  reused_ = 0;
+}
+
+std::size_t PairMemo::DescriptorHash::operator()(const BetaGridDescriptor& descriptor) const {
+  // Bytes, not values: -0.0 and 0.0 hash apart but compare equal, which only costs a miss.
+  Fnv1a64 hash;
+  hash.Bytes(descriptor.data(), sizeof(descriptor));
+  return static_cast<std::size_t>(hash.value());
+}
+
+// The rows of one query: those the memo held, moved out of it, and empty ones for the
+// descriptors it did not hold (`fresh`, each once however often the query holds it).
+struct PairMemoAccess::QueryRows {
+  PairMemo::Rows rows;
+  std::vector<BetaGridDescriptor> fresh;
+  std::vector<std::vector<PairMemo::Entry>*> fresh_rows;  // stable: the map's nodes do not move
+  std::vector<char> first_occurrence;                     // per query descriptor
+  std::size_t reused = 0;
+};
+
+PairMemoAccess::QueryRows PairMemoAccess::TakeRows(PairMemo& memo,
+                                                   const std::vector<BetaGridDescriptor>& query) {
+  QueryRows taken;
+  taken.rows.reserve(query.size());
+  taken.first_occurrence.assign(query.size(), 0);
+  for (std::size_t c = 0; c < query.size(); ++c) {
+    const BetaGridDescriptor& descriptor = query[c];
+    if (taken.rows.count(descriptor) != 0) continue;
+    taken.first_occurrence[c] = 1;
+    auto held = memo.rows_.find(descriptor);
+    if (held != memo.rows_.end()) {
+      taken.rows.emplace(descriptor, std::move(held->second));
+      ++taken.reused;
+    } else {
+      taken.fresh_rows.push_back(&taken.rows.emplace(descriptor, PairMemo::Row{}).first->second);
+      taken.fresh.push_back(descriptor);
+    }
+  }
+  return taken;
+}
+
+void PairMemoAccess::PairFresh(const SqrtDescriptorIndex& index, double chi2_threshold,
+                               QueryRows& taken) {
+  if (taken.fresh.empty()) return;
+  std::vector<std::vector<DescriptorPair>> below;
+  index.FindPairs(taken.fresh, chi2_threshold, std::vector<char>(index.places(), 1), below);
+  // Slot by slot, each slot's pairs by fresh row, then keypoint: every row's entries end up
+  // ordered by slot, then keypoint.
+  for (std::size_t slot = 0; slot < below.size(); ++slot) {
+    for (const DescriptorPair& pair : below[slot]) {
+      taken.fresh_rows[static_cast<std::size_t>(pair.current)]->push_back(
+          {static_cast<std::uint32_t>(slot), static_cast<std::uint32_t>(pair.reference),
+           pair.distance});
+    }
+  }
+}
+
+void PairMemoAccess::FindPairs(PairMemo& memo, const SqrtDescriptorIndex& index,
+                               const std::vector<BetaGridDescriptor>& query, double chi2_threshold,
+                               const std::vector<char>& searched,
+                               std::vector<std::vector<DescriptorPair>>& below) {
+  if (searched.size() != index.places()) {
+    throw std::invalid_argument("PairMemo: searched has " + std::to_string(searched.size()) +
+                                " entries for " + std::to_string(index.places()) + " places");
+  }
+  if (memo.index_id_ != index.id() || memo.index_keypoints_ != index.keypoints() ||
+      memo.chi2_threshold_ != chi2_threshold) {
+    memo.Clear();
+    memo.index_id_ = index.id();
+    memo.index_keypoints_ = index.keypoints();
+    memo.chi2_threshold_ = chi2_threshold;
+  }
+  QueryRows taken = TakeRows(memo, query);
+  PairFresh(index, chi2_threshold, taken);
+  below.assign(index.places(), {});
+  for (std::size_t c = 0; c < query.size(); ++c) {
+    for (const PairMemo::Entry& entry : taken.rows.at(query[c])) {
+      if (!searched[entry.slot]) continue;
+      below[entry.slot].push_back(
+          {static_cast<int>(c), static_cast<int>(entry.reference), entry.distance});
+    }
+  }
+  // Bounded memory whatever the map: the rows beyond the budget, in query order (a growing query
+  // keeps its first keypoints), are paired afresh next time.
+  std::size_t pairs = 0;
+  for (std::size_t c = 0; c < query.size(); ++c) {
+    if (!taken.first_occurrence[c]) continue;
+    auto row = taken.rows.find(query[c]);
+    if (pairs + row->second.size() > memo.max_pairs_) {
+      taken.rows.erase(row);
+    } else {
+      pairs += row->second.size();
+    }
+  }
+  memo.rows_ = std::move(taken.rows);
+  memo.pairs_ = pairs;
+  memo.reused_ = taken.reused;
+}
+
+}  // namespace keyplace
