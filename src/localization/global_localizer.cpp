@@ -169,19 +169,15 @@ LocalizationResult GlobalLocalizer::Localize(PairMemo* memo) const {
   // Holding a fix, an answer confirms it or contradicts it: the places near the fix and those
   // most like the query suffice (issue 30: on fr079-gmapping 0.91 of the updates were tracking,
   // at 12 ms each pairing all 529 places). Searching, a missed place is a lost answer.
-  const PlaceRecognitionConfig::Retrieval retrieval = config_.place.retrieval;
-  query.by_words = tracking_ && retrieval == PlaceRecognitionConfig::Retrieval::kAuto;
-  const bool retrieves = query.by_words || retrieval == PlaceRecognitionConfig::Retrieval::kWords;
+  query.by_words = tracking_ && config_.place.retrieval == PlaceRecognitionConfig::Retrieval::kAuto;
   // The words may leave out the place that would confirm a belief. Searched around the latest
   // scan, where the robot is, as a query may span 300 scans.
   const std::vector<Place>& places = recognizer_->places();
-  if (retrieves && config_.search_near_m > 0.0) {
-    for (const Pose2& T_world_odom : beliefs_) {
-      const std::vector<int> near = PlaceIdsNear(
-          places, places.size(), (T_world_odom * builder_.pose(latest)).translation(),
-          config_.search_near_m, static_cast<std::size_t>(config_.place.retrieval_places));
-      query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
-    }
+  for (const Pose2& T_world_odom : beliefs_) {
+    const std::vector<int> near = PlaceIdsToAlsoSearch(
+        config_.place, query.by_words, places, places.size(),
+        (T_world_odom * builder_.pose(latest)).translation(), config_.search_near_m);
+    query.also_search_ids.insert(query.also_search_ids.end(), near.begin(), near.end());
   }
   query.pair_memo = memo;
   std::vector<int> scan_ids = builder_.scan_ids();

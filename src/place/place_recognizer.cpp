@@ -78,12 +78,11 @@ std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t cand
   return ids;
 }
 
-std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config,
+std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config, bool by_words,
                                       const std::vector<Place>& places, std::size_t candidates,
                                       const Eigen::Vector2d& position_m, double radius_m) {
-  if (config.retrieval != PlaceRecognitionConfig::Retrieval::kWords || !(radius_m > 0.0)) {
-    return {};
-  }
+  const bool retrieves = by_words || config.retrieval == PlaceRecognitionConfig::Retrieval::kWords;
+  if (!retrieves || !(radius_m > 0.0)) return {};
   return PlaceIdsNear(places, candidates, position_m, radius_m,
                       static_cast<std::size_t>(config.retrieval_places));
 }

@@ -235,7 +235,7 @@ void OnlineSlam::CompleteSubmap(SlamStep& step) {
       for (std::size_t i = held; i < eligible; ++i) recognizer_->AddPlace(places_[i]);
     }
     ++stats_.queries;
-    query.also_search_ids = PlaceIdsToAlsoSearch(config_.place, places_, eligible,
+    query.also_search_ids = PlaceIdsToAlsoSearch(config_.place, query.by_words, places_, eligible,
                                                  places_.back().T_world_place.translation(),
                                                  config_.loop_search_near_m);
     step.match = recognizer_->Recognize(query);

@@ -324,12 +324,16 @@ TEST(PlaceIdsNear, NearestFirstWithinTheRadiusAmongTheCandidates) {
   EXPECT_EQ(PlaceIdsNear(places, 3, here, 3.0, 10), (std::vector<int>{11, 12}));  // first three
   EXPECT_EQ(PlaceIdsNear(places, 9, here, 0.9, 10), (std::vector<int>{13}));
   EXPECT_TRUE(PlaceIdsNear(places, 5, here, 0.1, 10).empty());
-  // What a query names: the same with retrieval words, nothing with exact or radius 0.
+  // What a query names: the same with retrieval words, nothing with exact, auto or radius 0.
   PlaceRecognitionConfig config = WordsConfig(2);
-  EXPECT_EQ(PlaceIdsToAlsoSearch(config, places, 5, here, 3.0), (std::vector<int>{13, 11}));
-  EXPECT_TRUE(PlaceIdsToAlsoSearch(config, places, 5, here, 0.0).empty());
-  config.retrieval = Retrieval::kExact;
-  EXPECT_TRUE(PlaceIdsToAlsoSearch(config, places, 5, here, 3.0).empty());
+  EXPECT_EQ(PlaceIdsToAlsoSearch(config, false, places, 5, here, 3.0), (std::vector<int>{13, 11}));
+  EXPECT_TRUE(PlaceIdsToAlsoSearch(config, false, places, 5, here, 0.0).empty());
+  for (Retrieval retrieval : {Retrieval::kExact, Retrieval::kAuto}) {
+    config.retrieval = retrieval;
+    EXPECT_TRUE(PlaceIdsToAlsoSearch(config, false, places, 5, here, 3.0).empty());
+    // A query by the words names them under any retrieval.
+    EXPECT_EQ(PlaceIdsToAlsoSearch(config, true, places, 5, here, 3.0), (std::vector<int>{13, 11}));
+  }
 }
 
 TEST(Retrieval, PlacesMustBePositive) {

@@ -47,9 +47,9 @@ std::vector<int> PlaceIdsNear(const std::vector<Place>& places, std::size_t cand
                               std::size_t count);
 
 /// What a query under `config` names near position_m (PlaceQuery::also_search_ids): PlaceIdsNear
-/// within radius_m, at most config.retrieval_places; none unless retrieval is `words` (`exact`
-/// pairs every place anyway) and radius_m > 0.
-std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config,
+/// within radius_m, at most config.retrieval_places; none unless the query retrieves (retrieval
+/// `words`, or a query `by_words`: the exact path pairs every place anyway) and radius_m > 0.
+std::vector<int> PlaceIdsToAlsoSearch(const PlaceRecognitionConfig& config, bool by_words,
                                       const std::vector<Place>& places, std::size_t candidates,
                                       const Eigen::Vector2d& position_m, double radius_m);
 
