@@ -1,6 +1,7 @@
 #include "place/pair_memo.hpp"
 
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -16,10 +17,22 @@ void PairMemo::Clear() {
 }
 
 std::size_t PairMemo::DescriptorHash::operator()(const BetaGridDescriptor& descriptor) const {
-  // Bytes, not values: -0.0 and 0.0 hash apart but compare equal, which only costs a miss.
   Fnv1a64 hash;
   hash.Bytes(descriptor.data(), sizeof(descriptor));
   return static_cast<std::size_t>(hash.value());
+}
+
+bool PairMemo::SameBytes::operator()(const BetaGridDescriptor& a,
+                                     const BetaGridDescriptor& b) const {
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    std::uint32_t bits_a = 0;
+    std::uint32_t bits_b = 0;
+    static_assert(sizeof(bits_a) == sizeof(a[k]), "a float has 32 bits");
+    std::memcpy(&bits_a, &a[k], sizeof(bits_a));
+    std::memcpy(&bits_b, &b[k], sizeof(bits_b));
+    if (bits_a != bits_b) return false;
+  }
+  return true;
 }
 
 // The rows of one query: those the memo held, moved out of it, and empty ones for the
@@ -32,7 +45,7 @@ struct PairMemoAccess::QueryRows {
   std::size_t reused = 0;
 };
 
-PairMemoAccess::QueryRows PairMemoAccess::TakeRows(PairMemo& memo,
+PairMemoAccess::QueryRows PairMemoAccess::TakeRows(PairMemo::Rows& held,
                                                    const std::vector<BetaGridDescriptor>& query) {
   QueryRows taken;
   taken.rows.reserve(query.size());
@@ -41,9 +54,9 @@ PairMemoAccess::QueryRows PairMemoAccess::TakeRows(PairMemo& memo,
     const BetaGridDescriptor& descriptor = query[c];
     if (taken.rows.count(descriptor) != 0) continue;
     taken.first_occurrence[c] = 1;
-    auto held = memo.rows_.find(descriptor);
-    if (held != memo.rows_.end()) {
-      taken.rows.emplace(descriptor, std::move(held->second));
+    auto row = held.find(descriptor);
+    if (row != held.end()) {
+      taken.rows.emplace(descriptor, std::move(row->second));
       ++taken.reused;
     } else {
       taken.fresh_rows.push_back(&taken.rows.emplace(descriptor, PairMemo::Row{}).first->second);
@@ -84,7 +97,13 @@ void PairMemoAccess::FindPairs(PairMemo& memo, const SqrtDescriptorIndex& index,
     memo.index_keypoints_ = index.keypoints();
     memo.chi2_threshold_ = chi2_threshold;
   }
-  QueryRows taken = TakeRows(memo, query);
+  // The rows leave the memo until the answer is made: if anything throws on the way, the memo is
+  // empty, never holding rows whose pairs were moved out.
+  PairMemo::Rows held;
+  held.swap(memo.rows_);
+  memo.pairs_ = 0;
+  memo.reused_ = 0;
+  QueryRows taken = TakeRows(held, query);
   PairFresh(index, chi2_threshold, taken);
   below.assign(index.places(), {});
   for (std::size_t c = 0; c < query.size(); ++c) {

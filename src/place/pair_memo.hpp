@@ -10,7 +10,8 @@
 
 namespace keyplace {
 
-struct PairMemoAccess {
+class PairMemoAccess {
+ public:
   /// index.FindPairs(query, chi2_threshold, searched, below), the same lists in the same order,
   /// pairing only the query descriptors `memo` does not hold (with every place of the index, so
   /// that a later query with other places searched can use them too). Afterwards `memo` holds
@@ -23,7 +24,8 @@ struct PairMemoAccess {
 
  private:
   struct QueryRows;
-  static QueryRows TakeRows(PairMemo& memo, const std::vector<BetaGridDescriptor>& query);
+  // Moves the rows of `query`'s descriptors out of `held`.
+  static QueryRows TakeRows(PairMemo::Rows& held, const std::vector<BetaGridDescriptor>& query);
   static void PairFresh(const SqrtDescriptorIndex& index, double chi2_threshold, QueryRows& taken);
 };
 

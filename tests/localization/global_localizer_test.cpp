@@ -326,10 +326,10 @@ TEST(GlobalLocalizer, QueryEveryMetreAnswersBeforeTheQueryCompletes) {
     const bool last_of_query =
         i + 1 == answers.size() || answers[i + 1].query_id != answers[i].query_id;
     // A query's later answers pair only the descriptors its earlier ones did not (PairMemo); its
-    // first pairs them all.
+    // first pairs them all (or none, with fewer keypoints than mu: -1).
     const bool first_of_query = i == 0 || answers[i].query_id != answers[i - 1].query_id;
     if (first_of_query) {
-      EXPECT_EQ(answers[i].match.descriptors_remembered, 0) << i;
+      EXPECT_LE(answers[i].match.descriptors_remembered, 0) << i;
     } else {
       EXPECT_GT(answers[i].match.descriptors_remembered, 0) << i;
     }

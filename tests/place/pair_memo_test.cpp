@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -104,6 +105,37 @@ TEST(PairMemo, GivesTheIndexsPairsAndPairsOnlyWhatItDoesNotHold) {
       previous = query;
     }
   }
+}
+
+// Descriptors are told apart by their bytes: a NaN bin (never equal to itself as a float) and a
+// -0.0 bin (equal to 0.0) get rows of their own, with the index's pairs.
+TEST(PairMemo, TellsDescriptorsApartByTheirBytes) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  const std::vector<BetaGridDescriptor> all = BundledDescriptors();
+  const SqrtDescriptorIndex index(places, Index::kDense);
+  const std::vector<char> every(index.places(), 1);
+  std::vector<BetaGridDescriptor> query = Window(all, 800, 840, 0);
+  const std::size_t distinct_before = Distinct(query);
+  BetaGridDescriptor with_nan = query[3];
+  with_nan[5] = std::numeric_limits<float>::quiet_NaN();
+  BetaGridDescriptor signed_zero = query[4];
+  std::size_t zero_bin = 0;
+  while (zero_bin < signed_zero.size() && signed_zero[zero_bin] != 0.0f) ++zero_bin;
+  ASSERT_LT(zero_bin, signed_zero.size());
+  signed_zero[zero_bin] = -0.0f;
+  query.push_back(with_nan);
+  query.push_back(signed_zero);
+  query.push_back(with_nan);
+  PairMemo memo;
+  std::vector<std::vector<DescriptorPair>> got;
+  std::vector<std::vector<DescriptorPair>> expected;
+  index.FindPairs(query, kChi2, every, expected);
+  for (int answer = 0; answer < 2; ++answer) {
+    PairMemoAccess::FindPairs(memo, index, query, kChi2, every, got);
+    ExpectSamePairs(got, expected, "answer " + std::to_string(answer));
+  }
+  EXPECT_EQ(memo.descriptors(), distinct_before + 2);
+  EXPECT_EQ(memo.reused(), distinct_before + 2);
 }
 
 // A memo too small for a query's rows keeps those of its first descriptors, and gives the same
@@ -211,6 +243,27 @@ TEST(PairMemo, ARecognizerAnswersAGrowingQueryTheSameWithIt) {
     EXPECT_EQ(recognizer.Recognize(by_words).descriptors_remembered, -1);
     EXPECT_EQ(memo.descriptors(), held);
   }
+}
+
+// A place removed from the recognizer (its slot no longer searched, its keypoints still in the
+// index) is not paired from the memo's rows either.
+TEST(PairMemo, APlaceRemovedIsNoLongerPairedFromTheRows) {
+  const std::vector<Place> places = PlacesFromMap(testing::BundledFr079().map);
+  PlaceRecognizer recognizer(places, PlaceRecognitionConfig{});
+  const std::vector<LocalizationQuery> queries = testing::BundledQueriesEvery(100);
+  ASSERT_FALSE(queries.empty());
+  PlaceQuery query = queries.front().query;
+  PairMemo memo;
+  query.pair_memo = &memo;
+  const PlaceMatch first = recognizer.Recognize(query);
+  ASSERT_TRUE(first.verified);
+  ASSERT_TRUE(recognizer.RemovePlace(first.place_id));
+  const PlaceMatch with = recognizer.Recognize(query);
+  EXPECT_GT(with.descriptors_remembered, 0);
+  query.pair_memo = nullptr;
+  const PlaceMatch without = recognizer.Recognize(query);
+  testing::ExpectSameMatch(with, without, "after RemovePlace");
+  EXPECT_NE(with.place_id, first.place_id);
 }
 
 }  // namespace

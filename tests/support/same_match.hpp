@@ -1,6 +1,7 @@
 #pragma once
-// Field-by-field equality of place-recognition answers (every field but the seconds_* timings),
-// for tests that two ways of answering agree exactly.
+// Field-by-field equality of place-recognition answers (every field but the seconds_* timings and
+// descriptors_remembered, which say how an answer was made), for tests that two ways of answering
+// agree exactly.
 
 #include <cstddef>
 #include <string>
@@ -32,7 +33,7 @@ inline void ExpectSameCandidate(const CandidateResult& a, const CandidateResult&
   EXPECT_EQ(a.score, b.score) << where;
 }
 
-// Every field but seconds_*.
+// Every field but seconds_* and descriptors_remembered.
 inline void ExpectSameMatch(const PlaceMatch& a, const PlaceMatch& b, const std::string& where) {
   EXPECT_EQ(a.verified, b.verified) << where;
   EXPECT_EQ(a.found, b.found) << where;
