@@ -36,12 +36,14 @@ bool PairMemo::SameBytes::operator()(const BetaGridDescriptor& a,
 }
 
 // The rows of one query: those the memo held, moved out of it, and empty ones for the
-// descriptors it did not hold (`fresh`, each once however often the query holds it).
+// descriptors it did not hold (`fresh`, each once however often the query holds it), with each
+// query descriptor's row found once.
 struct PairMemoAccess::QueryRows {
   PairMemo::Rows rows;
+  std::vector<PairMemo::Row*> row_of;  // per query descriptor; stable: the map's nodes stay put
+  std::vector<std::size_t> distinct;   // the query index of each descriptor's first occurrence
   std::vector<BetaGridDescriptor> fresh;
-  std::vector<std::vector<PairMemo::Entry>*> fresh_rows;  // stable: the map's nodes do not move
-  std::vector<char> first_occurrence;                     // per query descriptor
+  std::vector<PairMemo::Row*> fresh_rows;
   std::size_t reused = 0;
 };
 
@@ -49,18 +51,19 @@ PairMemoAccess::QueryRows PairMemoAccess::TakeRows(PairMemo::Rows& held,
                                                    const std::vector<BetaGridDescriptor>& query) {
   QueryRows taken;
   taken.rows.reserve(query.size());
-  taken.first_occurrence.assign(query.size(), 0);
+  taken.row_of.resize(query.size());
   for (std::size_t c = 0; c < query.size(); ++c) {
-    const BetaGridDescriptor& descriptor = query[c];
-    if (taken.rows.count(descriptor) != 0) continue;
-    taken.first_occurrence[c] = 1;
-    auto row = held.find(descriptor);
-    if (row != held.end()) {
-      taken.rows.emplace(descriptor, std::move(row->second));
+    const auto [row, inserted] = taken.rows.try_emplace(query[c]);
+    taken.row_of[c] = &row->second;
+    if (!inserted) continue;  // the query holds this descriptor twice
+    taken.distinct.push_back(c);
+    auto held_row = held.find(query[c]);
+    if (held_row != held.end()) {
+      row->second = std::move(held_row->second);
       ++taken.reused;
     } else {
-      taken.fresh_rows.push_back(&taken.rows.emplace(descriptor, PairMemo::Row{}).first->second);
-      taken.fresh.push_back(descriptor);
+      taken.fresh_rows.push_back(&row->second);
+      taken.fresh.push_back(query[c]);
     }
   }
   return taken;
@@ -107,7 +110,7 @@ void PairMemoAccess::FindPairs(PairMemo& memo, const SqrtDescriptorIndex& index,
   PairFresh(index, chi2_threshold, taken);
   below.assign(index.places(), {});
   for (std::size_t c = 0; c < query.size(); ++c) {
-    for (const PairMemo::Entry& entry : taken.rows.at(query[c])) {
+    for (const PairMemo::Entry& entry : *taken.row_of[c]) {
       if (!searched[entry.slot]) continue;
       below[entry.slot].push_back(
           {static_cast<int>(c), static_cast<int>(entry.reference), entry.distance});
@@ -116,13 +119,12 @@ void PairMemoAccess::FindPairs(PairMemo& memo, const SqrtDescriptorIndex& index,
   // Bounded memory whatever the map: the rows beyond the budget, in query order (a growing query
   // keeps its first keypoints), are paired afresh next time.
   std::size_t pairs = 0;
-  for (std::size_t c = 0; c < query.size(); ++c) {
-    if (!taken.first_occurrence[c]) continue;
-    auto row = taken.rows.find(query[c]);
-    if (pairs + row->second.size() > memo.max_pairs_) {
-      taken.rows.erase(row);
+  for (std::size_t c : taken.distinct) {
+    const std::size_t row_pairs = taken.row_of[c]->size();
+    if (pairs + row_pairs > memo.max_pairs_) {
+      taken.rows.erase(query[c]);
     } else {
-      pairs += row->second.size();
+      pairs += row_pairs;
     }
   }
   memo.rows_ = std::move(taken.rows);

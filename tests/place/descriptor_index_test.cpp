@@ -299,12 +299,7 @@ TEST(DescriptorIndex, FindsExactlyTheExhaustivePairsOnRandomDescriptors) {
             const std::vector<DescriptorPair> expected =
                 searched[p] ? ExhaustiveBelow(query, places[p].descriptors, threshold)
                             : std::vector<DescriptorPair>{};
-            ASSERT_EQ(below[p].size(), expected.size()) << "place " << p;
-            for (std::size_t k = 0; k < expected.size(); ++k) {
-              EXPECT_EQ(below[p][k].current, expected[k].current);
-              EXPECT_EQ(below[p][k].reference, expected[k].reference);
-              EXPECT_EQ(below[p][k].distance, expected[k].distance);  // bit for bit
-            }
+            testing::ExpectSamePairs(below[p], expected, "place " + std::to_string(p));
             pairs_seen += expected.size();
           }
         }
@@ -346,12 +341,8 @@ TEST(DescriptorIndex, DenseBlocksOfPlacesFindTheExhaustivePairs) {
         const std::vector<DescriptorPair> expected =
             searched[p] ? ExhaustiveBelow(query, places[p].descriptors, 0.4)
                         : std::vector<DescriptorPair>{};
-        ASSERT_EQ(below[p].size(), expected.size()) << rows << " rows, place " << p;
-        for (std::size_t k = 0; k < expected.size(); ++k) {
-          ASSERT_EQ(below[p][k].current, expected[k].current) << rows << " rows, place " << p;
-          ASSERT_EQ(below[p][k].reference, expected[k].reference) << rows << " rows, place " << p;
-          ASSERT_EQ(below[p][k].distance, expected[k].distance) << rows << " rows, place " << p;
-        }
+        testing::ExpectSamePairs(below[p], expected,
+                                 std::to_string(rows) + " rows, place " + std::to_string(p));
         pairs += expected.size();
       }
       EXPECT_GT(pairs, few ? rows / 20 : rows);  // the searched places had pairs to find

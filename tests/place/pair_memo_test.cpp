@@ -41,12 +41,7 @@ void ExpectSamePairs(const std::vector<std::vector<DescriptorPair>>& memo,
                      const std::string& where) {
   ASSERT_EQ(memo.size(), index.size()) << where;
   for (std::size_t p = 0; p < memo.size(); ++p) {
-    ASSERT_EQ(memo[p].size(), index[p].size()) << where << ", place " << p;
-    for (std::size_t k = 0; k < memo[p].size(); ++k) {
-      ASSERT_EQ(memo[p][k].current, index[p][k].current) << where << ", place " << p;
-      ASSERT_EQ(memo[p][k].reference, index[p][k].reference) << where << ", place " << p;
-      ASSERT_EQ(memo[p][k].distance, index[p][k].distance) << where << ", place " << p;
-    }
+    testing::ExpectSamePairs(memo[p], index[p], where + ", place " + std::to_string(p));
   }
 }
 

@@ -5,12 +5,24 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "keyplace/place/place_recognizer.hpp"
 
 namespace keyplace::testing {
+
+// The same descriptor pairs in the same order, distances bit for bit.
+inline void ExpectSamePairs(const std::vector<DescriptorPair>& a,
+                            const std::vector<DescriptorPair>& b, const std::string& where) {
+  ASSERT_EQ(a.size(), b.size()) << where;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].current, b[k].current) << where << ", pair " << k;
+    EXPECT_EQ(a[k].reference, b[k].reference) << where << ", pair " << k;
+    EXPECT_EQ(a[k].distance, b[k].distance) << where << ", pair " << k;
+  }
+}
 
 inline void ExpectSamePose(const Pose2& a, const Pose2& b, const std::string& where) {
   EXPECT_EQ(a.x, b.x) << where;
