@@ -73,6 +73,8 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
                 "translation step of the search")
         .Double("recovery_step_rotation_rad", &C::recovery_step_rotation_rad, "rad",
                 "rotation step of the search")
+        .Bool("grid_refinement", &C::grid_refinement,
+              "refine each ICP pose against a probability grid of the local map's key scans")
         .Nested("icp", &C::icp, IcpConfigFields());
     return table;
   }();

@@ -9,11 +9,20 @@
 
 #include "common/quantile.hpp"
 #include "correlative_search.hpp"
+#include "probability_grid.hpp"
 
 namespace keyplace {
 namespace {
 
 constexpr double kMaxRecoveryPoses = 1e6;
+// Cartographer's 2D submap resolution; 1024 cells of it span 51 m, beyond the 30 m of
+// ScanOdometryConfig::max_range_m around the middle half where the grid stays centred.
+constexpr double kGridCellM = 0.05;
+constexpr int kGridWidthCells = 1024;
+// Key scans in the grid: as many as a Cartographer 2D submap holds (num_range_data 90). Measured
+// against the ICP local map's 10 on FR079_r and Intel_r: the front end's drift (relations over
+// more than 5 s) 0.34 → 0.20 m and 0.77 → 0.50 m (docs/REGISTRATION.md).
+constexpr std::size_t kGridKeyScans = 90;
 // Scans over which the odometry's total judges a catch-up: longer than its stalls (Intel raw:
 // 13 scans with no motion, then 0.77 m at once), short enough that its drift over them stays far
 // below the correction bound it decides (25 scans of 5 cm: 1.25 m, a few cm of drift).
@@ -180,6 +189,11 @@ void ScanOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_laser,
   }
   target_ = std::make_unique<IcpTarget>(map_points_, std::move(map_normals), config_.icp);
   last_keyframe_T_world_laser_ = T_world_laser;
+  if (config_.grid_refinement) {
+    if (!grid_) grid_ = std::make_unique<ProbabilityGrid>(kGridCellM, kGridWidthCells);
+    grid_->Push({T_world_laser.translation(), keyframes_.back().points_world});
+    while (grid_->num_scans() > kGridKeyScans) grid_->Pop();
+  }
 }
 
 std::optional<IcpResult> ScanOdometry::Recover(const std::vector<Eigen::Vector2d>& source_laser,
@@ -311,13 +325,14 @@ Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
         disputing_motion
             ? MotionBetterByOdometryTotal(source, *disputing_motion, icp, odometry_laser)
             : std::nullopt;
-    if (better) {
+    if (better && MapSupportsBetter(source, better->T_target_source, icp.T_target_source)) {
       RecordIcp(*better, &result);
       result.status = ScanOdometryStatus::kRecovered;
       T_world_laser = better->T_target_source;
     }
   } else if (disputing_motion &&
-             WithinCorrectionBounds(Between(*disputing_motion, icp.T_target_source))) {
+             WithinCorrectionBounds(Between(*disputing_motion, icp.T_target_source)) &&
+             MapSupportsBetter(source, icp.T_target_source, predicted_T_world_laser)) {
     // ICP converged beyond the bound of the odometry's prediction, within that of the
     // motion's: the odometry glitched.
     result.status = ScanOdometryStatus::kRecovered;
@@ -333,14 +348,23 @@ Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
     const std::optional<Pose2> total =
         disputing_motion ? OdometryTotalDisputing(predicted_T_world_laser, odometry_laser)
                          : std::nullopt;
-    if (const std::optional<IcpResult> recovered =
-            RecoverFrom(source, predicted_T_world_laser, total)) {
+    const std::optional<IcpResult> recovered = RecoverFrom(source, predicted_T_world_laser, total);
+    if (recovered &&
+        MapSupportsBetter(source, recovered->T_target_source, predicted_T_world_laser)) {
       RecordIcp(*recovered, &result);
       result.status = ScanOdometryStatus::kRecovered;
       T_world_laser = recovered->T_target_source;
     }
   }
   return T_world_laser;
+}
+
+bool ScanOdometry::MapSupportsBetter(const std::vector<Eigen::Vector2d>& source,
+                                     const Pose2& candidate_T_world_laser,
+                                     const Pose2& alternative_T_world_laser) const {
+  if (!grid_) return true;
+  return MeanGridCost(*grid_, source, candidate_T_world_laser) <
+         MeanGridCost(*grid_, source, alternative_T_world_laser);
 }
 
 // Where the odometry's total since the oldest scan of the window puts this scan.
@@ -433,13 +457,20 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     }
     result.converged = IsIcpPose(result.status);
     result.fell_back = !result.converged;
+    const bool key_scan = !points.empty() && WantsKeyframe(T_world_laser, result.status);
+    if (key_scan && grid_ && result.converged) {
+      // Only key scans: they make the maps every later scan is registered against.
+      const GridMatch refined = MatchOnGrid(
+          *grid_, SubsampleBySpacing(points, config_.source_min_spacing_m), T_world_laser);
+      if (refined.converged) T_world_laser = refined.T_world_laser;
+    }
     result.T_world_laser = T_world_laser;
     if (result.status == ScanOdometryStatus::kRegistered && increment_measured) {
       RecordAgreement(result.inlier_ratio, Between(predicted_T_world_laser, T_world_laser),
                       odometry_increment);
     }
     result.T_world_robot = T_world_laser * T_robot_laser.inverse();
-    if (!points.empty() && WantsKeyframe(T_world_laser, result.status)) {
+    if (key_scan) {
       result.keyframe = true;
       AddKeyframe(points, T_world_laser);
     }

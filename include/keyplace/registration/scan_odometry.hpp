@@ -18,6 +18,8 @@
 
 namespace keyplace {
 
+class ProbabilityGrid;
+
 struct ScanOdometryConfig {
   IcpConfig icp;
 
@@ -72,6 +74,12 @@ struct ScanOdometryConfig {
   double recovery_window_rotation_rad = 1.5707963268;  // 90 deg
   double recovery_step_translation_m = 0.1;
   double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
+
+  // After ICP (registered or recovered), the pose is refined against an occupancy probability
+  // grid of the local map's key scans (5 cm cells, hits and the free space of their rays), as
+  // Cartographer's front end matches scans to submaps (docs/REGISTRATION.md, "Refinement on a
+  // probability grid").
+  bool grid_refinement = true;
 };
 
 /// Throws std::invalid_argument naming the first invalid field (including icp.*).
@@ -177,6 +185,12 @@ class ScanOdometry {
   Pose2 Register(const std::vector<Eigen::Vector2d>& points, const Pose2& predicted_T_world_laser,
                  const Pose2& odometry_step, const std::optional<Pose2>& disputing_motion,
                  const Pose2& odometry_laser, ScanOdometryResult& result) const;
+  /// With the grid (grid_refinement): whether the scan's points at `candidate_T_world_laser` fit
+  /// the grid better (lower mean correspondence cost) than at `alternative_T_world_laser`, the
+  /// pose the scan would take otherwise. Without it: true.
+  bool MapSupportsBetter(const std::vector<Eigen::Vector2d>& source,
+                         const Pose2& candidate_T_world_laser,
+                         const Pose2& alternative_T_world_laser) const;
   /// The previous ICP step repeated (constant velocity) when it parts from the odometry's
   /// prediction by more than the correction bounds (recovery on, odometry at this scan and the
   /// one before, the last scan converged); nullopt otherwise.
@@ -227,6 +241,8 @@ class ScanOdometry {
   std::deque<Keyframe> keyframes_;
   std::vector<Eigen::Vector2d> map_points_;  // concatenation of the keyframes' points
   std::unique_ptr<IcpTarget> target_;        // over map_points_
+  // The keyframes' occupancy (grid_refinement only).
+  std::unique_ptr<ProbabilityGrid> grid_;
 };
 
 }  // namespace keyplace
