@@ -121,8 +121,8 @@ TEST(MatchOnGrid, MovesAStartNearTheScanPoseTowardsIt) {
   std::mt19937 rng(3);
   const ProbabilityGrid grid = RoomGrid(rng);
   const Pose2 truth(-0.6, -0.9, DegToRad(25.0));
-  const LaserScan scan = CastScan(testing::IrregularRoom(), truth, testing::FrontLaser(361, 0.005),
-                                  &rng);
+  const LaserScan scan =
+      CastScan(testing::IrregularRoom(), truth, testing::FrontLaser(361, 0.005), &rng);
   const std::vector<Eigen::Vector2d> points =
       ScanOdometry::FilteredEndpoints(scan, ScanOdometryConfig{});
   const Pose2 start = truth * Pose2(0.02, -0.015, DegToRad(0.3));
