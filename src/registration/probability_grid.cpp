@@ -107,7 +107,7 @@ ProbabilityGrid::ProbabilityGrid(double cell_m, int width_cells)
   misses_.assign(cells, 0);
   costs_.assign(cells, static_cast<float>(1.0 - kMinProbability));
   last_scan_.assign(cells, 0);
-  cost_of_counts_.resize(kCountTableSize * kCountTableSize);
+  cost_of_counts_.resize(static_cast<std::size_t>(kCountTableSize) * kCountTableSize);
   for (int hits = 0; hits < kCountTableSize; ++hits) {
     for (int misses = 0; misses < kCountTableSize; ++misses) {
       cost_of_counts_[hits * kCountTableSize + misses] = CostOfCounts(hits, misses);
@@ -148,12 +148,14 @@ void ProbabilityGrid::CentreOn(const Eigen::Vector2d& position_world) {
 }
 
 std::int32_t ProbabilityGrid::IndexOf(const Eigen::Vector2d& point_world) const {
-  const Eigen::Vector2d cell = (point_world - origin_) / cell_m_;
-  if (!(cell.x() > -0.5 && cell.y() > -0.5 && cell.x() < width_ - 0.5 && cell.y() < width_ - 0.5)) {
+  // Shifted by half a cell, as the ray traversal: the cell is the integer part.
+  const Eigen::Vector2d shifted =
+      (point_world - origin_) / cell_m_ + Eigen::Vector2d::Constant(0.5);
+  if (!(shifted.x() >= 0.0 && shifted.y() >= 0.0 && shifted.x() < width_ && shifted.y() < width_)) {
     return -1;
   }
-  const int column = static_cast<int>(cell.x() + 0.5);
-  const int row = static_cast<int>(cell.y() + 0.5);
+  const int column = static_cast<int>(std::floor(shifted.x()));
+  const int row = static_cast<int>(std::floor(shifted.y()));
   return row * width_ + column;
 }
 
