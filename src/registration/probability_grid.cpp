@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <ceres/ceres.h>
 #include <ceres/cubic_interpolation.h>
@@ -19,8 +20,31 @@ constexpr double kTranslationWeightPerM = 10.0;
 constexpr double kRotationWeightPerRad = 40.0;
 constexpr int kMaxIterations = 20;
 
-using CostGrid = ceres::Grid2D<float, 1>;
-using CostInterpolator = ceres::BiCubicInterpolator<CostGrid>;
+// The grid's correspondence costs as Ceres's interpolator reads them: outside the grid the cost of
+// a cell no ray reached (Ceres's Grid2D would repeat the edge cell, often a miss, and give a point
+// beyond it a false gradient along the edge).
+class PaddedCosts {
+ public:
+  enum { DATA_DIMENSION = 1 };
+
+  explicit PaddedCosts(const ProbabilityGrid& grid)
+      : costs_(grid.correspondence_costs()), width_(grid.width()) {}
+
+  void GetValue(int row, int column, double* value) const {
+    if (row < 0 || column < 0 || row >= width_ || column >= width_) {
+      *value = 1.0 - ProbabilityGrid::kMinProbability;
+      return;
+    }
+    *value = costs_[static_cast<std::size_t>(row) * static_cast<std::size_t>(width_) +
+                    static_cast<std::size_t>(column)];
+  }
+
+ private:
+  const std::vector<float>& costs_;
+  int width_;
+};
+
+using CostInterpolator = ceres::BiCubicInterpolator<PaddedCosts>;
 
 // Every point's correspondence cost at the candidate pose (x, y, θ), with the analytic
 // Jacobian: one rotation per evaluation instead of automatic differentiation per point.
@@ -116,6 +140,9 @@ ProbabilityGrid::ProbabilityGrid(double cell_m, int width_cells)
 }
 
 void ProbabilityGrid::Push(GridScan scan) {
+  if (scans_.size() >= kMaxScans) {
+    throw std::length_error("ProbabilityGrid: more than 32767 scans held (a cell counts each)");
+  }
   Inserted inserted;
   inserted.scan = std::move(scan);
   const Eigen::Vector2d origin = inserted.scan.origin_world;
@@ -258,8 +285,8 @@ double ProbabilityGrid::Probability(int column, int row) const {
 double MeanGridCost(const ProbabilityGrid& grid, const std::vector<Eigen::Vector2d>& points_laser,
                     const Pose2& T_world_laser) {
   if (points_laser.empty()) return 1.0 - ProbabilityGrid::kMinProbability;
-  const CostGrid cost_grid(grid.correspondence_costs().data(), 0, grid.width(), 0, grid.width());
-  const CostInterpolator interpolator(cost_grid);
+  const PaddedCosts costs(grid);
+  const CostInterpolator interpolator(costs);
   const OccupiedSpaceCost cost(interpolator, points_laser, grid.origin(), grid.cell_m());
   std::vector<double> residuals(points_laser.size());
   const double pose[3] = {T_world_laser.x, T_world_laser.y, T_world_laser.theta};
@@ -275,8 +302,8 @@ GridMatch MatchOnGrid(const ProbabilityGrid& grid, const std::vector<Eigen::Vect
   GridMatch match;
   match.T_world_laser = initial_T_world_laser;
   if (points_laser.empty()) return match;
-  const CostGrid cost_grid(grid.correspondence_costs().data(), 0, grid.width(), 0, grid.width());
-  const CostInterpolator interpolator(cost_grid);
+  const PaddedCosts costs(grid);
+  const CostInterpolator interpolator(costs);
   double pose[3] = {initial_T_world_laser.x, initial_T_world_laser.y, initial_T_world_laser.theta};
   ceres::Problem problem;
   problem.AddResidualBlock(

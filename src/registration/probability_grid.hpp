@@ -28,15 +28,21 @@ struct GridScan {
 /// inserter probabilities, 0.55 and 0.49). Counting them lets the oldest scan be taken out
 /// exactly, so a scan costs one insertion and one removal instead of a rebuild per key scan.
 /// The grid is `width_cells` cells per side, centred on a scan's origin; when a new scan's origin
-/// lies more than a quarter of the width from the centre, it is centred again on that origin and
-/// refilled from the scans it holds. What lies beyond it is left out (a point there costs the
-/// most, with no gradient), so its memory stays bounded whatever the ranges.
+/// lies more than a quarter of the width from the centre (L∞), it is centred again on that origin
+/// and refilled from the scans it holds. What lies beyond it is left out, and a point there costs
+/// what an unobserved cell does. Memory: 12 bytes per cell, plus 4 bytes per cell each held scan
+/// touched (its hits and the cells its rays crossed).
 class ProbabilityGrid {
  public:
   /// Throws std::invalid_argument unless cell_m is finite and > 0 and width_cells in [8, 8192].
   ProbabilityGrid(double cell_m, int width_cells);
+  ProbabilityGrid(const ProbabilityGrid&) = delete;
+  ProbabilityGrid& operator=(const ProbabilityGrid&) = delete;
+  ProbabilityGrid(ProbabilityGrid&&) = default;
+  ProbabilityGrid& operator=(ProbabilityGrid&&) = default;
 
-  /// Adds the newest scan.
+  /// Adds the newest scan. A scan with a non-finite origin is left out, as are non-finite points.
+  /// Throws std::length_error when kMaxScans are held already: a cell's counts are 16-bit.
   void Push(GridScan scan);
   /// Takes the oldest scan out (none: no effect).
   void Pop();
@@ -55,6 +61,7 @@ class ProbabilityGrid {
 
   static constexpr double kMinProbability = 0.1;
   static constexpr double kMaxProbability = 0.9;
+  static constexpr std::size_t kMaxScans = 32767;
 
  private:
   struct Inserted {

@@ -74,7 +74,9 @@ const ConfigFields<ScanOdometryConfig>& ScanOdometryConfigFields() {
         .Double("recovery_step_rotation_rad", &C::recovery_step_rotation_rad, "rad",
                 "rotation step of the search")
         .Bool("grid_refinement", &C::grid_refinement,
-              "refine each ICP pose against a probability grid of the local map's key scans")
+              "refine key scans on a probability grid of the last 90, and take a recovery only "
+              "where it "
+              "fits that grid better")
         .Nested("icp", &C::icp, IcpConfigFields());
     return table;
   }();

@@ -15,8 +15,9 @@ namespace keyplace {
 namespace {
 
 constexpr double kMaxRecoveryPoses = 1e6;
-// Cartographer's 2D submap resolution; 1024 cells of it span 51 m, beyond the 30 m of
-// ScanOdometryConfig::max_range_m around the middle half where the grid stays centred.
+// Cartographer's 2D submap resolution; 1024 cells of it span 51 m, so points up to 12.8 m from
+// the laser always lie in the grid (it is centred again when the laser leaves its middle half),
+// and farther ones of the 30 m of ScanOdometryConfig::max_range_m often do.
 constexpr double kGridCellM = 0.05;
 constexpr int kGridWidthCells = 1024;
 // Key scans in the grid: as many as a Cartographer 2D submap holds (num_range_data 90). Measured

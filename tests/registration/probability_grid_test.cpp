@@ -86,9 +86,36 @@ TEST(ProbabilityGrid, MovesWithTheRobotAndKeepsTheScansItHolds) {
   EXPECT_NEAR(ProbabilityAt(grid, {1.0, 1.0}), hit, 1e-6);
   EXPECT_NEAR(ProbabilityAt(grid, {3.0, 1.0}), hit, 1e-6);
   EXPECT_NEAR(ProbabilityAt(grid, {5.0, 1.0}), hit, 1e-6);
-  // A point beyond the grid is left out, not wrapped around.
-  grid.Push({{4.0, 0.0}, {{4.0 + 20.0, 0.0}}});
+  // A point beyond the grid is left out, not wrapped around into the next row.
+  const Eigen::Vector2d beyond(4.0 + 7.0, 1.0);
+  grid.Push({{4.0, 0.0}, {beyond}});
   EXPECT_EQ(grid.num_scans(), 4u);
+  const Eigen::Vector2d wrapped = beyond + Eigen::Vector2d(-kWidth * kCellM, kCellM);
+  EXPECT_NEAR(ProbabilityAt(grid, wrapped), ProbabilityGrid::kMinProbability, 1e-6);
+}
+
+TEST(ProbabilityGrid, PoppingAfterTheGridMovedLeavesTheGridOfTheOthers) {
+  const GridScan first{{0.0, 0.0}, {{1.0, 1.0}, {-1.0, 2.0}}};
+  const GridScan second{{4.0, 0.5}, {{5.0, 1.0}, {3.0, 2.5}, {1.0, 1.0}}};
+  ProbabilityGrid both(kCellM, kWidth);
+  both.Push(first);
+  both.Push(second);  // 4 m away: the grid centres on it and refills
+  both.Pop();
+  ProbabilityGrid only_second(kCellM, kWidth);
+  only_second.Push(second);
+  EXPECT_EQ(both.origin(), only_second.origin());
+  EXPECT_EQ(both.correspondence_costs(), only_second.correspondence_costs());
+}
+
+TEST(ProbabilityGrid, SkipsWhatIsNotFinite) {
+  const double nan = std::nan("");
+  ProbabilityGrid grid(kCellM, kWidth);
+  grid.Push({{nan, 0.0}, {{1.0, 0.0}}});  // no origin: the scan is left out
+  EXPECT_EQ(grid.num_scans(), 0u);
+  grid.Push({{0.0, 0.0}, {}});  // no points: held, nothing marked
+  grid.Push({{0.0, 0.0}, {{nan, 1.0}, {2.0, 0.0}, {1e300, 0.0}}});
+  EXPECT_EQ(grid.num_scans(), 2u);
+  EXPECT_NEAR(ProbabilityAt(grid, {2.0, 0.0}), Logistic(std::log(0.55 / 0.45)), 1e-6);
 }
 
 TEST(ProbabilityGrid, RejectsAnInvalidCellOrWidth) {
@@ -137,6 +164,18 @@ TEST(MatchOnGrid, MovesAStartNearTheScanPoseTowardsIt) {
   const double at_truth = MeanGridCost(grid, points, truth);
   EXPECT_LT(at_truth, MeanGridCost(grid, points, start));
   EXPECT_LT(at_truth + 0.2, MeanGridCost(grid, points, truth * Pose2(0.0, 0.0, DegToRad(20.0))));
+}
+
+TEST(MatchOnGrid, APointBeyondTheGridCostsWhatAnUnobservedCellDoes) {
+  ProbabilityGrid grid(kCellM, kWidth);
+  // A ray along the grid's bottom row to beyond its edge: that row's edge cell is a miss.
+  const double bottom_y = grid.origin().y();
+  grid.Push({{0.0, 0.0}, {{1.0, 0.0}}});
+  grid.Push({{0.0, bottom_y}, {{30.0, bottom_y}}});
+  const Pose2 identity;
+  const double unobserved = 1.0 - ProbabilityGrid::kMinProbability;
+  EXPECT_NEAR(MeanGridCost(grid, {{20.0, bottom_y - 1.0}}, identity), unobserved, 1e-9);
+  EXPECT_NEAR(MeanGridCost(grid, {{40.0, bottom_y}}, identity), unobserved, 1e-9);
 }
 
 TEST(MatchOnGrid, WithoutPointsKeepsTheStart) {

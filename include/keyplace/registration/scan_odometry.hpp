@@ -75,10 +75,11 @@ struct ScanOdometryConfig {
   double recovery_step_translation_m = 0.1;
   double recovery_step_rotation_rad = 0.0174532925;  // 1 deg
 
-  // After ICP (registered or recovered), the pose is refined against an occupancy probability
-  // grid of the local map's key scans (5 cm cells, hits and the free space of their rays), as
-  // Cartographer's front end matches scans to submaps (docs/REGISTRATION.md, "Refinement on a
-  // probability grid").
+  // A scan that becomes a key scan has its ICP pose (registered or recovered) refined against an
+  // occupancy probability grid of the last 90 key scans (5 cm cells, hits and the free space of
+  // their rays), as Cartographer's front end matches scans to submaps, and a recovered pose is
+  // taken only where that grid supports it better than the pose it would replace
+  // (docs/REGISTRATION.md, "Key scans refined on a probability grid").
   bool grid_refinement = true;
 };
 
