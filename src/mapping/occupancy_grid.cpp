@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "common/ray_cells.hpp"
+
 namespace keyplace {
 namespace {
 
@@ -106,41 +108,20 @@ class ScanInserter {
     stamp_[index] = stamp;
   }
 
-  // Frees every cell the ray crosses before its end cell (Amanatides-Woo traversal).
+  // Frees every cell the ray crosses before its end cell.
   void Trace(const Ray& ray, std::uint32_t miss_stamp) {
     const double resolution_m = grid_.resolution_m;
     const Eigen::Vector2d from = (ray.from_m - grid_.origin_m) / resolution_m;
     const Eigen::Vector2d to = (ray.to_m - grid_.origin_m) / resolution_m;
-    int column = static_cast<int>(std::floor(from.x()));
-    int row = static_cast<int>(std::floor(from.y()));
-    const int end_column = static_cast<int>(std::floor(to.x()));
-    const int end_row = static_cast<int>(std::floor(to.y()));
-    const Eigen::Vector2d direction = to - from;
-    const int step_x = direction.x() > 0 ? 1 : -1;
-    const int step_y = direction.y() > 0 ? 1 : -1;
-    const double inf = std::numeric_limits<double>::infinity();
-    const double delta_x = direction.x() != 0 ? std::abs(1.0 / direction.x()) : inf;
-    const double delta_y = direction.y() != 0 ? std::abs(1.0 / direction.y()) : inf;
-    const double first_x = step_x > 0 ? column + 1 - from.x() : from.x() - column;
-    const double first_y = step_y > 0 ? row + 1 - from.y() : from.y() - row;
-    double next_x = direction.x() != 0 ? first_x * delta_x : inf;
-    double next_y = direction.y() != 0 ? first_y * delta_y : inf;
-    const int steps = std::abs(end_column - column) + std::abs(end_row - row);
-    for (int step = 0; step < steps; ++step) {
-      // Ties in next_x/next_y can end a step off the exact end cell: never leave the grid.
-      if (column < 0 || row < 0 || column >= grid_.width || row >= grid_.height) return;
+    ForEachCellBeforeEnd(from, to, [&](int column, int row) {
+      // Ties in the traversal can end a step off the exact end cell: never leave the grid.
+      if (column < 0 || row < 0 || column >= grid_.width || row >= grid_.height) return false;
       const std::size_t index = grid_.Index(column, row);
       if (stamp_[index] != miss_stamp && stamp_[index] != miss_stamp - 1) {
         Update(index, miss_, miss_stamp);
       }
-      if (next_x < next_y) {
-        column += step_x;
-        next_x += delta_x;
-      } else {
-        row += step_y;
-        next_y += delta_y;
-      }
-    }
+      return true;
+    });
   }
 
   OccupancyGrid& grid_;

@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <utility>
 
 #include <ceres/ceres.h>
 #include <ceres/cubic_interpolation.h>
+
+#include "common/ray_cells.hpp"
 
 namespace keyplace {
 namespace {
@@ -204,52 +205,19 @@ void ProbabilityGrid::Insert(Inserted& inserted) {
       (inserted.scan.origin_world - origin_) / cell_m_ + Eigen::Vector2d::Constant(0.5);
   for (const Eigen::Vector2d& p : inserted.scan.points_world) {
     const Eigen::Vector2d to = (p - origin_) / cell_m_ + Eigen::Vector2d::Constant(0.5);
-    if (!to.allFinite() || !from.allFinite() || (to - from).lpNorm<Eigen::Infinity>() > 1e6) {
-      continue;
-    }
-    RayCells(from, to, scan, inserted.miss_cells);
+    ForEachCellBeforeEnd(from, to, [&](int column, int row) {
+      if (column >= 0 && row >= 0 && column < width_ && row < width_) {
+        const std::int32_t index = row * width_ + column;
+        if (last_scan_[index] != scan) {
+          last_scan_[index] = scan;
+          inserted.miss_cells.push_back(index);
+        }
+      }
+      return true;
+    });
   }
   Count(inserted.hit_cells, hits_, 1);
   Count(inserted.miss_cells, misses_, 1);
-}
-
-void ProbabilityGrid::RayCells(const Eigen::Vector2d& from, const Eigen::Vector2d& to,
-                               std::uint32_t scan, std::vector<std::int32_t>& cells) {
-  std::int64_t column = static_cast<std::int64_t>(std::floor(from.x()));
-  std::int64_t row = static_cast<std::int64_t>(std::floor(from.y()));
-  const std::int64_t end_column = static_cast<std::int64_t>(std::floor(to.x()));
-  const std::int64_t end_row = static_cast<std::int64_t>(std::floor(to.y()));
-  const Eigen::Vector2d direction = to - from;
-  const int step_column = direction.x() > 0.0 ? 1 : -1;
-  const int step_row = direction.y() > 0.0 ? 1 : -1;
-  const auto first_crossing = [](double position, double delta, std::int64_t cell) {
-    if (delta == 0.0) return std::numeric_limits<double>::infinity();
-    const double boundary = delta > 0.0 ? static_cast<double>(cell + 1) : static_cast<double>(cell);
-    return (boundary - position) / delta;
-  };
-  double next_column_t = first_crossing(from.x(), direction.x(), column);
-  double next_row_t = first_crossing(from.y(), direction.y(), row);
-  const double column_t_step = direction.x() != 0.0 ? 1.0 / std::abs(direction.x())
-                                                    : std::numeric_limits<double>::infinity();
-  const double row_t_step = direction.y() != 0.0 ? 1.0 / std::abs(direction.y())
-                                                 : std::numeric_limits<double>::infinity();
-  const std::int64_t crossings = std::abs(end_column - column) + std::abs(end_row - row);
-  for (std::int64_t k = 0; k < crossings; ++k) {
-    if (column >= 0 && row >= 0 && column < width_ && row < width_) {
-      const std::int32_t index = static_cast<std::int32_t>(row * width_ + column);
-      if (last_scan_[index] != scan) {
-        last_scan_[index] = scan;
-        cells.push_back(index);
-      }
-    }
-    if (next_column_t < next_row_t) {
-      column += step_column;
-      next_column_t += column_t_step;
-    } else {
-      row += step_row;
-      next_row_t += row_t_step;
-    }
-  }
 }
 
 void ProbabilityGrid::Count(const std::vector<std::int32_t>& cells,

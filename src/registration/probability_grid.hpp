@@ -71,10 +71,6 @@ class ProbabilityGrid {
   };
   void CentreOn(const Eigen::Vector2d& position_world);
   void Insert(Inserted& inserted);
-  /// Adds the cells from `from` up to the one before `to` (cell coordinates + ½) that scan
-  /// `scan` has not updated yet.
-  void RayCells(const Eigen::Vector2d& from, const Eigen::Vector2d& to, std::uint32_t scan,
-                std::vector<std::int32_t>& cells);
   void Count(const std::vector<std::int32_t>& cells, std::vector<std::int16_t>& counts, int sign);
   void UpdateCost(std::int32_t index);
   static float CostOfCounts(int hits, int misses);
