@@ -149,7 +149,7 @@ void ProbabilityGrid::Push(GridScan scan) {
   const Eigen::Vector2d origin = inserted.scan.origin_world;
   const double recentre_m = 0.25 * width_ * cell_m_;
   if (!origin.allFinite()) return;
-  if (scans_.empty() || (origin - centre_).lpNorm<Eigen::Infinity>() > recentre_m) {
+  if (scans_.empty() || (origin - Centre()).lpNorm<Eigen::Infinity>() > recentre_m) {
     scans_.push_back(std::move(inserted));
     CentreOn(origin);
     return;
@@ -166,9 +166,12 @@ void ProbabilityGrid::Pop() {
   scans_.pop_front();
 }
 
+Eigen::Vector2d ProbabilityGrid::Centre() const {
+  return origin_ + Eigen::Vector2d::Constant(0.5 * (width_ - 1) * cell_m_);
+}
+
 void ProbabilityGrid::CentreOn(const Eigen::Vector2d& position_world) {
-  centre_ = position_world;
-  origin_ = centre_ - Eigen::Vector2d::Constant(0.5 * (width_ - 1) * cell_m_);
+  origin_ = position_world - Eigen::Vector2d::Constant(0.5 * (width_ - 1) * cell_m_);
   std::fill(hits_.begin(), hits_.end(), 0);
   std::fill(misses_.begin(), misses_.end(), 0);
   std::fill(costs_.begin(), costs_.end(), static_cast<float>(1.0 - kMinProbability));
@@ -288,7 +291,6 @@ GridMatch MatchOnGrid(const ProbabilityGrid& grid, const std::vector<Eigen::Vect
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  match.iterations = static_cast<int>(summary.iterations.size());
   match.converged = summary.IsSolutionUsable() && std::isfinite(pose[0]) &&
                     std::isfinite(pose[1]) && std::isfinite(pose[2]);
   if (match.converged) match.T_world_laser = Pose2(pose[0], pose[1], pose[2]);

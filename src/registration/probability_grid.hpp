@@ -70,6 +70,7 @@ class ProbabilityGrid {
     std::vector<std::int32_t> miss_cells;
   };
   void CentreOn(const Eigen::Vector2d& position_world);
+  Eigen::Vector2d Centre() const;  // where the grid was last centred
   void Insert(Inserted& inserted);
   void Count(const std::vector<std::int32_t>& cells, std::vector<std::int16_t>& counts, int sign);
   void UpdateCost(std::int32_t index);
@@ -81,7 +82,6 @@ class ProbabilityGrid {
 
   double cell_m_;
   int width_;
-  Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   std::deque<Inserted> scans_;
   std::vector<std::int16_t> hits_;
@@ -100,7 +100,6 @@ double MeanGridCost(const ProbabilityGrid& grid, const std::vector<Eigen::Vector
 struct GridMatch {
   Pose2 T_world_laser;
   bool converged = false;  // Ceres reported a usable solution
-  int iterations = 0;
 };
 
 /// The pose of `points_laser` that best fits the grid near `initial_T_world_laser`: the sum of

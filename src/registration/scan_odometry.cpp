@@ -300,13 +300,11 @@ std::optional<IcpResult> ScanOdometry::MotionBetterByOdometryTotal(
 
 // ICP from the prediction, the checks of its result and the recovery: the scan's pose, and its
 // status and ICP figures in `result` (the prediction itself when the scan falls back).
-Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& points,
+Pose2 ScanOdometry::Register(const std::vector<Eigen::Vector2d>& source,
                              const Pose2& predicted_T_world_laser, const Pose2& odometry_step,
                              const std::optional<Pose2>& disputing_motion,
                              const Pose2& odometry_laser, ScanOdometryResult& result) const {
   Pose2 T_world_laser = predicted_T_world_laser;
-  const std::vector<Eigen::Vector2d> source =
-      SubsampleBySpacing(points, config_.source_min_spacing_m);
   const IcpResult icp = AlignPointToLine(*target_, source, predicted_T_world_laser, config_.icp);
   RecordIcp(icp, &result);
   const Pose2 correction = Between(predicted_T_world_laser, icp.T_target_source);
@@ -447,12 +445,15 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     const Pose2 predicted_T_world_laser = previous_T_world_laser_ * odometry_increment;
     result.T_world_robot_odometry_prediction = predicted_T_world_laser * T_robot_laser.inverse();
     Pose2 T_world_laser = predicted_T_world_laser;
+    // The points registered (ICP, the recovery) and refined on the grid.
+    std::vector<Eigen::Vector2d> source;
     if (target_ == nullptr || static_cast<int>(points.size()) < config_.icp.min_points ||
         static_cast<int>(map_points_.size()) < config_.icp.min_points) {
       result.status = ScanOdometryStatus::kFallbackTooFewPoints;
       result.icp_status = IcpStatus::kTooFewPoints;
     } else {
-      T_world_laser = Register(points, predicted_T_world_laser, odometry_increment,
+      source = SubsampleBySpacing(points, config_.source_min_spacing_m);
+      T_world_laser = Register(source, predicted_T_world_laser, odometry_increment,
                                DisputingMotion(predicted_T_world_laser, increment_measured),
                                odometry_laser, result);
     }
@@ -461,8 +462,7 @@ ScanOdometryResult ScanOdometry::Add(const LaserScan& scan,
     const bool key_scan = !points.empty() && WantsKeyframe(T_world_laser, result.status);
     if (key_scan && grid_ && result.converged) {
       // Only key scans: they make the maps every later scan is registered against.
-      const GridMatch refined = MatchOnGrid(
-          *grid_, SubsampleBySpacing(points, config_.source_min_spacing_m), T_world_laser);
+      const GridMatch refined = MatchOnGrid(*grid_, source, T_world_laser);
       if (refined.converged) T_world_laser = refined.T_world_laser;
     }
     result.T_world_laser = T_world_laser;

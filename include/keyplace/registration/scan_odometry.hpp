@@ -182,8 +182,9 @@ class ScanOdometry {
                                        const std::optional<Pose2>& total) const;
   /// ICP from the prediction, its checks and the recovery: the scan's pose (the prediction when
   /// it falls back), with the status and ICP figures written to `result`.
-  /// `odometry_step`: the odometry's increment since the previous scan (laser frame).
-  Pose2 Register(const std::vector<Eigen::Vector2d>& points, const Pose2& predicted_T_world_laser,
+  /// `source`: the scan's points thinned by source_min_spacing_m. `odometry_step`: the
+  /// odometry's increment since the previous scan (laser frame).
+  Pose2 Register(const std::vector<Eigen::Vector2d>& source, const Pose2& predicted_T_world_laser,
                  const Pose2& odometry_step, const std::optional<Pose2>& disputing_motion,
                  const Pose2& odometry_laser, ScanOdometryResult& result) const;
   /// With the grid (grid_refinement): whether the scan's points at `candidate_T_world_laser` fit
