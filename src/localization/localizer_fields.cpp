@@ -55,6 +55,12 @@ const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
         .Double("search_near_m", &C::search_near_m, "m",
                 "retrieval words, or auto while a fix is held: queries also pair the places this "
                 "close to where a pending answer or the fix puts the robot (0 = words alone)")
+        .Double("map_search_window_m", &C::map_search_window_m, "m",
+                "without a fix, search the whole map with the beams of the scans over this much "
+                "odometry, once per this distance (0 = never)")
+        .Double("map_search_margin", &C::map_search_margin, "",
+                "... a pose is an answer when its mean closeness beats every distinct pose's by "
+                "this")
         .Nested("fix", &C::fix, FixPolicyFields());
     return table;
   }();

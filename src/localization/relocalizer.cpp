@@ -33,13 +33,17 @@ std::string ToString(FixStatus status) {
 
 Relocalizer::Relocalizer(const GlobalMap& map, const LocalizerConfig& config,
                          const FlirtConfig& features)
-    : localizer_(map, config, features), filter_(config.fix), track_(config.fix.agree_deg) {}
+    : localizer_(map, config, features),
+      filter_(config.fix),
+      track_(config.fix.agree_deg),
+      map_search_(config.map_search_window_m, config.map_search_margin) {}
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot) {
   RememberForTrackCheck(scan, T_odom_robot, -1);
+  map_search_.AddScan(scan, T_odom_robot, -1);
   localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
   RelocalizationUpdate update =
-      filter_.Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
+      filter_.Update(AnswerOf(localizer_.AddScan(scan, T_odom_robot)), T_odom_robot);
   CheckTrack(T_odom_robot, update);
   return update;
 }
@@ -47,17 +51,37 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
                                           std::vector<Keypoint> keypoints, int scan_id) {
   RememberForTrackCheck(scan, T_odom_robot, scan_id);
+  map_search_.AddScan(scan, T_odom_robot, scan_id);
   localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
   RelocalizationUpdate update = filter_.Update(
-      localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id), T_odom_robot);
+      AnswerOf(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id)),
+      T_odom_robot);
   CheckTrack(T_odom_robot, update);
   return update;
+}
+
+std::optional<LocalizationResult> Relocalizer::AnswerOf(
+    std::optional<LocalizationResult> localizer_answer) {
+  if (filter_.status() == FixStatus::kFixed) {
+    map_search_answer_.reset();
+    return localizer_answer;
+  }
+  if (std::optional<LocalizationResult> found =
+          map_search_.Search(localizer_.recognizer(), localizer_.exclusion())) {
+    map_search_answer_ = std::move(found);
+  }
+  if (localizer_answer) return localizer_answer;
+  std::optional<LocalizationResult> answer = std::move(map_search_answer_);
+  map_search_answer_.reset();
+  return answer;
 }
 
 void Relocalizer::Reset() {
   localizer_.Reset();
   filter_.Reset();
   track_.Reset();
+  map_search_.Reset();
+  map_search_answer_.reset();
   last_T_odom_robot_.reset();
   since_check_m_ = 0.0;
 }

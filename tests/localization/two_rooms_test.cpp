@@ -79,6 +79,15 @@ TEST(TwoRooms, NoFixUntilMotionTellsTheRoomsApartThenTheRightOne) {
   EXPECT_EQ(outcome.wrong_fixes, 0);
 }
 
+TEST(TwoRooms, TheSearchOfTheWholeMapDoesNotFixInOneOfTheRoomsEither) {
+  LocalizerConfig config;
+  config.map_search_window_m = 5.0;  // off by default (docs/LOCALIZATION.md)
+  const QueryOutcome outcome = KidnappedIntoRoomB(config);
+  EXPECT_EQ(outcome.fixes_in_room, 0);
+  EXPECT_GT(outcome.fixes, 0);
+  EXPECT_EQ(outcome.wrong_fixes, 0);
+}
+
 TEST(TwoRooms, WithoutTheTemporalCheckTheWrongRoomIsAFix) {
   LocalizerConfig config;
   config.fix.confirmations = 1;  // every accepted answer is a fix

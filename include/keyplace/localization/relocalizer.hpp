@@ -28,6 +28,7 @@
 #include "keyplace/features/keypoint.hpp"
 #include "keyplace/io/laser_scan.hpp"
 #include "keyplace/localization/global_localizer.hpp"
+#include "keyplace/localization/map_search.hpp"
 #include "keyplace/localization/track_check.hpp"
 #include "keyplace/mapping/global_map.hpp"
 
@@ -198,10 +199,16 @@ class Relocalizer {
   void RememberForTrackCheck(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   // The track check of FixPolicy::track_check_every_m, on `update` of the scan just added.
   void CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& update);
+  // The localizer's answer of this scan, or else a search of the whole map's answer, when one is
+  // due and the filter has no fix (an answer found on a scan that has the localizer's waits for
+  // the next scan without one).
+  std::optional<LocalizationResult> AnswerOf(std::optional<LocalizationResult> localizer_answer);
 
   GlobalLocalizer localizer_;
   FixFilter filter_;
   TrackCheck track_;
+  MapSearch map_search_;
+  std::optional<LocalizationResult> map_search_answer_;  // waiting for a scan without an answer
   std::optional<Pose2> last_T_odom_robot_;
   double since_check_m_ = 0.0;  // odometry since the fix or its last check
 };
