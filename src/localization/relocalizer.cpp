@@ -115,6 +115,7 @@ void Relocalizer::CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& up
   // The odometry, not the map, went wrong: the query being built spans the error too, and its
   // answers would put the robot where the error did.
   localizer_.Reset();
+  map_search_.Reset();
   filter_.GiveUp(update);
   update.track_misfit = true;
 }

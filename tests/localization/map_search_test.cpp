@@ -3,6 +3,7 @@
 
 #include "keyplace/localization/map_search.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <random>
@@ -15,6 +16,7 @@
 #include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/relocalizer.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
+#include "keyplace/place/dense_check.hpp"
 #include "localization/simulated_drive.hpp"
 
 namespace keyplace {
@@ -122,19 +124,25 @@ TEST(MapSearch, FindsWhereTheBeamsFitInAnOpenHall) {
   const SimulatedDrive drive = HallQuery();
   MapSearch search(5.0, LocalizerConfig{}.map_search_margin);
   int found = 0;
+  double path_m = 0.0;
+  std::optional<double> answered_at_m;
   for (std::size_t i = 0; i < drive.scans.size(); ++i) {
+    if (i > 0) path_m += TranslationNorm(Between(drive.truth[i - 1], drive.truth[i]));
     search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
     const std::optional<LocalizationResult> answer = search.Search(recognizer, {});
     if (!answer) continue;
     ++found;
     SCOPED_TRACE(i);
+    // A search once per 5 m, after the first 5 m.
+    EXPECT_GE(path_m - answered_at_m.value_or(0.0), 5.0 - 1e-9);
+    answered_at_m = path_m;
     EXPECT_TRUE(answer->found);
-    EXPECT_TRUE(Near(answer->T_world_robot, drive.truth[i], 0.3, 3.0));
+    EXPECT_DOUBLE_EQ(answer->confidence, LocalizerConfig{}.map_search_margin);
+    EXPECT_TRUE(Near(answer->T_world_robot, drive.truth[i], 0.3, 3.5));
     // The map <- odometry correction carries the robot's pose (its error grows with the lever
     // arm from the odometry origin, so it is checked through the robot).
     EXPECT_TRUE(Near(answer->T_world_odom * (kTWorldOdom.inverse() * drive.truth[i]),
                      answer->T_world_robot, 1e-6, 1e-6));
-    EXPECT_GT(answer->confidence, 0.0);
     EXPECT_EQ(answer->scan_ids.back(), static_cast<int>(i));
   }
   // One search per 5 m of the 37 m drive, nearly every one finding the robot.
@@ -155,11 +163,38 @@ TEST(MapSearch, SaysNothingInOneOfTwoIdenticalRooms) {
   const MapSearchResult result = field.Search(points, 0.5, LocalizerConfig{}.map_search_margin);
   EXPECT_FALSE(result.found);
   EXPECT_GT(result.score, 0.8);
-  EXPECT_GE(result.runner_up, result.score - LocalizerConfig{}.map_search_margin);
+  EXPECT_GE(result.rival_score, result.score - LocalizerConfig{}.map_search_margin);
   const Pose2 truth = drive.truth[40];
   const Pose2 in_room_a(truth.x - 20.0, truth.y, truth.theta);
   EXPECT_TRUE(Near(result.T_world_robot, truth, 0.3, 3.0) ||
               Near(result.T_world_robot, in_room_a, 0.3, 3.0));
+}
+
+// The branch and bound finds the pose an exhaustive search over every turn and cell scores best,
+// with beams that fall off the field at every edge for some of them.
+TEST(MapSearch, FindsWhatScoringEveryPoseFinds) {
+  // The field of room A's first places alone: small enough to score every pose.
+  const std::vector<Place>& places = Recognizer().places();
+  std::vector<char> use(places.size(), 0);
+  for (std::size_t p = 0; p < std::min<std::size_t>(3, places.size()); ++p) use[p] = 1;
+  const MapField field(places, use);
+  ASSERT_FALSE(field.empty());
+  const SimulatedDrive drive = Simulate(TwoRooms(), Drive({{-12, -2}, {-8, -2}}), 8);
+  const std::vector<Eigen::Vector2d> points = DenseScanPoints(drive.scans[10]).endpoints_m;
+  double best = 0.0;
+  for (int k = 0; k < kMapSearchRotations; ++k) {
+    const double theta = 2.0 * M_PI * k / kMapSearchRotations;
+    for (int y = 0; y < field.height(); ++y) {
+      for (int x = 0; x < field.width(); ++x) {
+        const Eigen::Vector2d at = field.origin() + field.cell_m() * Eigen::Vector2d(x, y);
+        best = std::max(best, field.ScoreAt(points, Pose2(at.x(), at.y(), theta)));
+      }
+    }
+  }
+  const MapSearchResult result = field.Search(points, 0.3, 0.0);
+  EXPECT_NEAR(result.score, best, 1e-6);
+  EXPECT_NEAR(field.ScoreAt(points, result.T_world_robot), result.score, 1e-6);
+  EXPECT_GT(result.nodes, 0);
 }
 
 TEST(MapSearch, AnEmptyMapOrWindowFindsNothing) {

@@ -94,7 +94,7 @@ struct LocalizerConfig {
   // of the scans over the last map_search_window_m of odometry fit (MapSearch), once per that
   // distance; a pose that fits better by map_search_margin (of the mean closeness, 0..1) than
   // every pose distinct from it is an accepted answer. 0: never (the default: a search costs
-  // 0.05-0.5 s on a map of a floor and seconds on one of 90 x 40 m, docs/LOCALIZATION.md).
+  // 0.05-0.26 s on a map of a floor and 3-5 s on one of 92 x 44 m, docs/LOCALIZATION.md).
   double map_search_window_m = 0.0;
   double map_search_margin = 0.08;
   FixPolicy fix;  // the Relocalizer's

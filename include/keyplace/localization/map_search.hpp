@@ -5,8 +5,8 @@
 // every pose of the map, every 2 degrees and every cell, for the one that puts the recent beams
 // on the map's occupied cells, by branch and bound over a pyramid of maxima of a closeness field
 // (the global search of Hess et al., "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016), and
-// then for the best pose distinct from it (more than kDistinctM or kDistinctDeg away). The
-// answer counts only when the best beats every distinct pose by a margin: a corridor or two
+// then for a pose distinct from it (more than kMapSearchDistinctM or kMapSearchDistinctDeg away)
+// that scores nearly as well. The answer counts only when there is none: a corridor or two
 // look-alike rooms fit several poses nearly as well, and then nothing is said
 // (docs/LOCALIZATION.md, "Search of the whole map").
 
@@ -19,7 +19,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "keyplace/common/pose2.hpp"
 #include "keyplace/io/laser_scan.hpp"
@@ -31,63 +30,78 @@ namespace keyplace {
 /// Two poses of a search are distinct when they lie this far apart or are turned by this much.
 inline constexpr double kMapSearchDistinctM = 1.0;
 inline constexpr double kMapSearchDistinctDeg = 20.0;
-/// Rotations over the circle a search tries at most (every 2 degrees).
+/// Turns a search tries: every 2 degrees of the circle.
 inline constexpr int kMapSearchRotations = 180;
+/// A map whose field would hold more cells is not searched (its field is empty): 2^24 cells of
+/// 0.2 m are 820 x 820 m, and the field's pyramid holds a byte per cell and level.
+inline constexpr std::size_t kMapSearchMaxCells = std::size_t{1} << 24;
 
 struct MapSearchResult {
   bool found = false;   // the best pose beats every distinct pose by the margin asked for
   Pose2 T_world_robot;  // the best pose (valid when score > 0)
   double score = 0.0;   // mean closeness of the points there, 0..1
-  // The best score of a pose distinct from the best (0 when none scores above the search's floor).
-  double runner_up = 0.0;
+  // When not found: the score of a distinct pose within the margin of the best (the first the
+  // search met, not necessarily the best of them); 0 when found or when nothing scored.
+  double rival_score = 0.0;
   long long nodes = 0;  // poses and boxes of poses scored (the search's cost)
 };
 
 /// The map's occupancy as a closeness field exp(-d² / 2σ²) of the distance d to the nearest
-/// occupied cell (σ = 1.5 cells, 0 beyond 3σ) on the map's own cells, quantized to a byte, with
-/// the maxima over squares of 2^h cells that bound a box of translations from above.
+/// occupied cell, on cells twice the map's (0.2 m for its 0.1 m), σ = 1.5 cells, cut at 5 cells;
+/// quantized to a byte, with the maxima over squares of 2^h cells that bound a box of
+/// translations from above.
 class MapField {
  public:
-  /// The field of the places marked in `use` (all when empty), their Place::occupancy_cells put
-  /// into the world by T_world_place. An empty field (no occupied cell) finds nothing.
+  /// The field of the places marked in `use` (all when empty; otherwise one flag per place), their
+  /// Place::occupancy_cells put into the world by T_world_place. A field without occupied cells,
+  /// or of more than kMapSearchMaxCells, is empty and finds nothing.
+  /// Throws std::invalid_argument when `use` is neither empty nor one flag per place.
   explicit MapField(const std::vector<Place>& places, const std::vector<char>& use = {});
 
-  /// The best pose of points (robot frame) and whether a distinct one comes within min_margin
-  /// of it. `found` when the best scores at least min_score and none does.
+  /// The best pose of points (robot frame) over every turn and cell, and whether a distinct one
+  /// comes within min_margin of it. `found` when the best scores above min_score and none does.
   MapSearchResult Search(const std::vector<Eigen::Vector2d>& points_robot, double min_score,
                          double min_margin) const;
 
+  /// The points' mean closeness at a pose, as the search scores its poses (a pose at a cell
+  /// centre, turned by a multiple of 2 degrees, scores exactly what the search gives it).
+  double ScoreAt(const std::vector<Eigen::Vector2d>& points_robot,
+                 const Pose2& T_world_robot) const;
+
   bool empty() const { return width_ == 0; }
   double cell_m() const { return cell_m_; }
+  /// World position of the centre of cell (0, 0) and the cells per side.
+  const Eigen::Vector2d& origin() const { return origin_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
 
  private:
-  // A box of 2^level x 2^level translations (robot cells from x, y) at one rotation.
+  // A box of 2^level x 2^level translations (robot cells from x, y) at one turn.
   struct Node {
     float bound = 0.0F;
-    int rotation = 0;
+    int rotation = 0;  // of kMapSearchRotations
     int x = 0;
     int y = 0;
   };
-  // The points' cell offsets at one rotation.
-  struct Rotation {
-    int index = 0;  // of kRotations over the circle
-    double theta_rad = 0.0;
-    std::vector<Eigen::Vector2i> offsets;
-  };
+  // The points' cell offsets at each turn.
+  using Offsets = std::vector<Eigen::Vector2i>;
   // Called at each pose (level 0) that scores above the floor; may raise the floor.
-  using Visit = std::function<void(const Node&, float& floor)>;
-  // Mean closeness of the rotation's points with the robot in cell (x, y), at `level`: an upper
-  // bound of the score of every translation of the box. Once it cannot exceed `floor` the sum
-  // stops, and the value returned is still a bound, at or below the floor.
-  float Bound(const Rotation& rotation, int x, int y, int level, float floor) const;
-  // Depth first, best bound first; boxes not above the floor are pruned.
-  void Branch(const std::vector<Rotation>& rotations, std::vector<Node>& nodes, int level,
-              float& floor, const Visit& visit, long long& count) const;
-  std::vector<Rotation> Rotations(const std::vector<Eigen::Vector2d>& points_robot) const;
-  bool Distinct(const std::vector<Rotation>& rotations, const Node& a, const Node& b) const;
+  using Visit = std::function<void(const Node&, float& floor_score)>;
 
-  double cell_m_ = 0.1;
-  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();  // world position of cell (0, 0)'s centre
+  void BuildField(const std::vector<Eigen::Vector2i>& world_cells);
+  void BuildPyramid();
+  // Mean closeness of the points (offsets) with the robot in cell (x, y), at `level`: an upper
+  // bound of the score of every translation of the box. Once it cannot exceed `floor_score` the
+  // sum stops, and the value returned is still a bound, at or below the floor.
+  float Bound(const Offsets& offsets, int x, int y, int level, float floor_score) const;
+  // Depth first, best bound first; boxes not above the floor are pruned.
+  void Branch(const std::vector<Offsets>& rotations, Node* nodes, std::size_t count, int level,
+              float& floor_score, const Visit& visit, long long& scored) const;
+  std::vector<Offsets> Rotations(const std::vector<Eigen::Vector2d>& points_robot) const;
+  bool Distinct(const Node& a, const Node& b) const;
+
+  double cell_m_ = 0.2;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   int width_ = 0;
   int height_ = 0;
   std::vector<std::vector<std::uint8_t>> levels_;  // levels_[h]: maxima over 2^h x 2^h cells
@@ -95,7 +109,9 @@ class MapField {
 
 /// Feeds the Relocalizer answers from searches of the whole map while it has no fix: every
 /// `window_m` of odometry, the beams of the scans over the last window_m (DenseScanPoints) are
-/// searched (MapField::Search); a pose found becomes an accepted answer.
+/// searched (MapField::Search); a pose found becomes an accepted answer. The field is kept
+/// between searches for the same recognizer and the same places allowed; a recognizer changed
+/// in place (PlaceRecognizer::AddPlace) needs Reset(true).
 class MapSearch {
  public:
   /// window_m <= 0: never searches.
@@ -106,8 +122,8 @@ class MapSearch {
   /// for the window's scan ids; rebuilt only when they change).
   std::optional<LocalizationResult> Search(const PlaceRecognizer& recognizer,
                                            const QueryExclusion& exclusion);
-  /// Forgets the scans and the distance since the last search (not the field).
-  void Reset();
+  /// Forgets the scans and the distance since the last search, and the field with forget_field.
+  void Reset(bool forget_field = false);
 
  private:
   struct Recent {
@@ -117,12 +133,15 @@ class MapSearch {
     double odometry_m = 0.0;  // path since construction or Reset
   };
   const MapField& FieldFor(const PlaceRecognizer& recognizer, const std::vector<char>& use);
+  // The window's beams in the latest scan's frame, thinned, and the window's scan ids.
+  std::vector<Eigen::Vector2d> WindowPoints(std::vector<int>& scan_ids) const;
 
   double window_m_;
   double min_margin_;
-  std::deque<Recent> recent_;
+  std::deque<Recent> recent_;  // scans at least a few cm or degrees apart
+  std::optional<Pose2> last_T_odom_robot_;
   double odometry_m_ = 0.0;
-  double searched_at_m_ = 0.0;
+  std::optional<double> searched_at_m_;
   std::shared_ptr<const MapField> field_;
   std::vector<char> field_use_;
   const PlaceRecognizer* field_recognizer_ = nullptr;

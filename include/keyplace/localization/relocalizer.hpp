@@ -67,7 +67,8 @@ struct RelocalizationUpdate {
   // odometry) plus the same drift allowance as the variances above, plus the map's own error
   // (FixPolicy::map_sigma_m, map_sigma_deg). What /initialpose gets.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  // The localizer's answer when a query submap completed with this scan.
+  // The localizer's answer when a query submap completed with this scan, or else a search of the
+  // whole map's (LocalizerConfig::map_search_window_m; submap_id -1, an empty match).
   std::optional<LocalizationResult> answer;
   // The answer (accepted, or weak: LocalizationResult::weak_T_world_odom) agreed with the fix
   // (confirmation) or contradicted it.
