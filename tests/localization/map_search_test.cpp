@@ -6,14 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "keyplace/features/flirt.hpp"
 #include "keyplace/localization/relocalizer.hpp"
 #include "keyplace/mapping/global_mapper.hpp"
 #include "keyplace/place/dense_check.hpp"
@@ -85,26 +83,16 @@ std::vector<testing::Segment> OpenHall() {
   return world;
 }
 
-// Scans of the hall every metre along `waypoints` (true poses; keypoints by FLIRT).
+// Scans of the hall about every metre along `waypoints` (true poses; keypoints by FLIRT), from
+// a full-circle laser of 20 m.
 SimulatedDrive HallDrive(const std::vector<Eigen::Vector2d>& waypoints, unsigned seed) {
-  const std::vector<Pose2> dense = Drive(waypoints);
+  const std::vector<Pose2> dense = Drive(waypoints);  // 0.15 m steps
   std::vector<Pose2> sparse;
-  for (std::size_t i = 0; i < dense.size(); i += 7) sparse.push_back(dense[i]);  // 0.15 m steps
-  SimulatedDrive run;
-  run.truth = sparse;
+  for (std::size_t i = 0; i < dense.size(); i += 7) sparse.push_back(dense[i]);
   testing::ScanOptions options;
   options.max_range_m = 20.0;
   options.range_noise_m = 0.01;
-  std::mt19937 rng(seed);
-  const FlirtExtractor extractor;
-  for (std::size_t i = 0; i < sparse.size(); ++i) {
-    LogScan scan;
-    static_cast<LaserScan&>(scan) = testing::CastScan(OpenHall(), sparse[i], options, &rng);
-    scan.timestamp_s = scan.logger_timestamp_s = static_cast<double>(i);
-    run.keypoints.push_back(extractor.Extract(scan, sparse[i]));
-    run.scans.push_back(std::move(scan));
-  }
-  return run;
+  return Simulate(OpenHall(), sparse, seed, options);
 }
 
 const GlobalMap& HallMap() {

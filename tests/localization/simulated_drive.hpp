@@ -106,13 +106,18 @@ struct SimulatedDrive {
   std::vector<std::vector<Keypoint>> keypoints;
 };
 
-inline SimulatedDrive Simulate(const std::vector<Segment>& world, const std::vector<Pose2>& truth,
-                               unsigned seed) {
-  SimulatedDrive run;
-  run.truth = truth;
+// A full-circle laser of 10 m, 5 mm range noise: the drives of the two rooms.
+inline ScanOptions RoomLaser() {
   ScanOptions options;
   options.max_range_m = 10.0;
   options.range_noise_m = 0.005;
+  return options;
+}
+
+inline SimulatedDrive Simulate(const std::vector<Segment>& world, const std::vector<Pose2>& truth,
+                               unsigned seed, const ScanOptions& options = RoomLaser()) {
+  SimulatedDrive run;
+  run.truth = truth;
   std::mt19937 rng(seed);
   const FlirtExtractor extractor;
   for (std::size_t i = 0; i < truth.size(); ++i) {
