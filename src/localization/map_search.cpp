@@ -153,19 +153,12 @@ double MapField::ScoreAt(const std::vector<Eigen::Vector2d>& points_robot,
   return static_cast<double>(sum) / (255.0 * static_cast<double>(points_robot.size()));
 }
 
-float MapField::Bound(const Offsets& offsets, int x, int y, int level, float floor_score) const {
+float MapField::Bound(const Offsets& offsets, int x, int y, int level) const {
   const std::vector<std::uint8_t>& values = levels_[static_cast<std::size_t>(level)];
   const int reach = (1 << level) - 1;  // the box's translations reach this many cells further
-  const int count = static_cast<int>(offsets.size());
-  const float scale = 1.0F / (255.0F * static_cast<float>(count));
+  const float scale = 1.0F / (255.0F * static_cast<float>(offsets.size()));
   int sum = 0;
-  for (int k = 0; k < count; ++k) {
-    // Once the points left could not lift the sum above the floor, the box is pruned anyway.
-    if ((k & 15) == 0) {
-      const float at_most = static_cast<float>(sum + 255 * (count - k)) * scale;
-      if (at_most <= floor_score) return at_most;
-    }
-    const Eigen::Vector2i& offset = offsets[static_cast<std::size_t>(k)];
+  for (const Eigen::Vector2i& offset : offsets) {
     int column = x + offset.x();
     int row = y + offset.y();
     if (column + reach < 0 || row + reach < 0 || column >= width_ || row >= height_) continue;
@@ -198,8 +191,8 @@ void MapField::Branch(const std::vector<Offsets>& rotations, Node* nodes, std::s
       for (const int dx : {0, half}) {
         if (node.x + dx >= width_ || node.y + dy >= height_) continue;
         Node child{0.0F, node.rotation, node.x + dx, node.y + dy};
-        child.bound = Bound(rotations[static_cast<std::size_t>(child.rotation)], child.x, child.y,
-                            level - 1, floor_score);
+        child.bound =
+            Bound(rotations[static_cast<std::size_t>(child.rotation)], child.x, child.y, level - 1);
         ++scored;
         if (child.bound > floor_score) children[kept++] = child;
       }
@@ -240,7 +233,7 @@ MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robo
   for (int k = 0; k < kRotations; ++k) {
     for (int y = 0; y < height_; y += step_cells) {
       for (int x = 0; x < width_; x += step_cells) {
-        roots.push_back({Bound(rotations[static_cast<std::size_t>(k)], x, y, top, -1.0F), k, x, y});
+        roots.push_back({Bound(rotations[static_cast<std::size_t>(k)], x, y, top), k, x, y});
       }
     }
   }

@@ -91,9 +91,8 @@ class MapField {
   void BuildField(const std::vector<Eigen::Vector2i>& world_cells);
   void BuildPyramid();
   // Mean closeness of the points (offsets) with the robot in cell (x, y), at `level`: an upper
-  // bound of the score of every translation of the box. Once it cannot exceed `floor_score` the
-  // sum stops, and the value returned is still a bound, at or below the floor.
-  float Bound(const Offsets& offsets, int x, int y, int level, float floor_score) const;
+  // bound of the score of every translation of the box.
+  float Bound(const Offsets& offsets, int x, int y, int level) const;
   // Depth first, best bound first; boxes not above the floor are pruned.
   void Branch(const std::vector<Offsets>& rotations, Node* nodes, std::size_t count, int level,
               float& floor_score, const Visit& visit, long long& scored) const;
