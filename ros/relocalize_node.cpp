@@ -47,10 +47,11 @@ class RelocalizeNode {
     const NodeStatus status = core_.status();
     ROS_INFO(
         "keyplace: %zu scans received, %zu processed, %zu dropped, %zu waiting; per scan %.1f ms "
-        "mean, "
-        "%.1f ms p99, %.1f ms max",
+        "mean, %.1f ms p99, %.1f ms max; %lld searches of the whole map in the background, %.1f "
+        "ms each",
         status.scans_received, status.scans_processed, status.scans_dropped, status.scans_waiting,
-        1e3 * status.latency_mean_s, 1e3 * status.latency_p99_s, 1e3 * status.latency_max_s);
+        1e3 * status.latency_mean_s, 1e3 * status.latency_p99_s, 1e3 * status.latency_max_s,
+        status.map_searches, 1e3 * status.map_search_mean_s);
   }
 
  private:
@@ -129,6 +130,7 @@ class RelocalizeNode {
       value("last_answer_stamp", DiagnosticNumber(answer.stamp_s));
       value("last_answer", answer.found ? "found" : answer.ambiguous ? "ambiguous" : "not found");
       value("last_answer_confidence", DiagnosticNumber(answer.confidence));
+      value("last_answer_source", answer.map_search ? "map search" : "keypoints");
     }
     value("scans_received", std::to_string(status.scans_received));
     value("scans_processed", std::to_string(status.scans_processed));
@@ -142,6 +144,8 @@ class RelocalizeNode {
     value("latency_mean_s", DiagnosticNumber(status.latency_mean_s));
     value("latency_p99_s", DiagnosticNumber(status.latency_p99_s));
     value("latency_max_s", DiagnosticNumber(status.latency_max_s));
+    value("map_searches", std::to_string(status.map_searches));
+    value("map_search_mean_s", DiagnosticNumber(status.map_search_mean_s));
     diagnostic_msgs::DiagnosticArray array;
     array.header.stamp = ros::Time::now();
     array.status.push_back(diagnostic);

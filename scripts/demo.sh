@@ -37,10 +37,11 @@ tail -1 "$out/localize-stream.txt"
 echo
 echo "== Kidnapped robot on a map recorded earlier: the map of the first half of the log, 12 starts"
 echo "   in the second half; the Relocalizer fixes when answers agree (two, one accepted, or three"
-echo "   weak ones along 10 m: keyplace relocalize)"
+echo "   weak ones along 10 m), answers of keypoints or of a search of the whole map by the beams"
+echo "   of the last 5 m (keyplace relocalize; the search's own time on the 'search' line)"
 "$keyplace" map "$log" --scans 0:732 --out "$out/map-first-half.kpm" >/dev/null
 "$keyplace" relocalize --map "$out/map-first-half.kpm" --log "$log" --scans 732: --starts 12 \
-  --json "$out/relocalize.json" --figure "$out/relocalize.png" | sed -n '3,11p'
+  --json "$out/relocalize.json" --figure "$out/relocalize.png" | sed -n '3,13p'
 echo
 echo "== A robot's own log, no truth: the first 150 raw scans of the same run with their wheel"
 echo "   odometry (the first 37 corrected scans), relocalized as a robot would be on the map of"

@@ -41,6 +41,12 @@ void PrintLogRelocalization(const LogRelocalization& run, const LogInputs& input
              run.losses, run.answers, fixed_scans, run.scans.size());
   fmt::print("update       {:.2f} ms mean, {:.1f} ms max per scan (keypoints given)\n",
              1e3 * run.update_seconds_mean, 1e3 * run.update_seconds_max);
+  if (run.map_searches > 0) {
+    fmt::print(
+        "search       {} of the whole map, mean {:.1f} ms (a robot's node runs them in the "
+        "background)\n",
+        run.map_searches, 1e3 * run.map_search_seconds / static_cast<double>(run.map_searches));
+  }
 }
 
 void WriteScanStatusTsv(const std::string& path, const LogRelocalization& run) {

@@ -57,6 +57,13 @@ void PrintRelocalizeReport(const RelocalizeReport& r, const GlobalMap& map) {
              r.seconds_keypoints_per_scan
                  ? fmt::format("FLIRT {:.2f} ms per scan", 1e3 * *r.seconds_keypoints_per_scan)
                  : std::string("keypoints read from the cache"));
+  if (s.map_searches > 0) {
+    fmt::print(
+        "search       {} of the whole map, mean {:.1f} ms; updates without them mean {:.2f} ms "
+        "(a robot's node runs them in the background)\n",
+        s.map_searches, 1e3 * s.map_search_seconds_mean,
+        1e3 * s.update_seconds_mean_without_search);
+  }
   fmt::print("time         {:.1f} s\n", r.seconds_total);
 }
 

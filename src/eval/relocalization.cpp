@@ -99,6 +99,8 @@ class StartRun {
     double travelled_m = 0.0;
     double fixed_at_m = 0.0;
     double seconds_sum = 0.0;
+    const long long searches_before = relocalizer_.map_search().searches();
+    const double search_s_before = relocalizer_.map_search().search_s();
     std::size_t k = static_cast<std::size_t>(start_scan);
     for (; k < scans; ++k) {
       if (k > static_cast<std::size_t>(start_scan)) {
@@ -123,6 +125,8 @@ class StartRun {
     record_.end_scan = static_cast<int>(k);
     const int fed = record_.end_scan - start_scan;
     if (fed > 0) record_.update_seconds_mean = seconds_sum / fed;
+    record_.map_searches = static_cast<int>(relocalizer_.map_search().searches() - searches_before);
+    record_.map_search_seconds = relocalizer_.map_search().search_s() - search_s_before;
     return record_;
   }
 
@@ -247,6 +251,7 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   std::vector<double> after_revisit;
   std::vector<double> scans_to_fix;
   double seconds_sum = 0.0;
+  double search_seconds_sum = 0.0;
   std::size_t updates = 0;
   for (const StartRecord& r : records) {
     s.starts_with_revisit += r.revisit ? 1 : 0;
@@ -276,6 +281,8 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
     seconds_sum += r.update_seconds_mean * fed;
     updates += static_cast<std::size_t>(std::max(fed, 0));
     s.update_seconds_max = std::max(s.update_seconds_max, r.update_seconds_max);
+    s.map_searches += static_cast<std::size_t>(r.map_searches);
+    search_seconds_sum += r.map_search_seconds;
   }
   if (s.starts_with_revisit > 0) {
     s.fixed_fraction = static_cast<double>(s.fixed_with_revisit) / s.starts_with_revisit;
@@ -289,7 +296,14 @@ RelocalizationSummary SummarizeRelocalization(const std::vector<StartRecord>& re
   s.scans_to_fix_median = Quantile(scans_to_fix, 0.5);
   s.distance_after_revisit_median_m = Quantile(after_revisit, 0.5);
   s.distance_after_revisit_p90_m = Quantile(after_revisit, 0.9);
-  if (updates > 0) s.update_seconds_mean = seconds_sum / static_cast<double>(updates);
+  if (updates > 0) {
+    s.update_seconds_mean = seconds_sum / static_cast<double>(updates);
+    s.update_seconds_mean_without_search =
+        std::max(0.0, seconds_sum - search_seconds_sum) / static_cast<double>(updates);
+  }
+  if (s.map_searches > 0) {
+    s.map_search_seconds_mean = search_seconds_sum / static_cast<double>(s.map_searches);
+  }
   return s;
 }
 

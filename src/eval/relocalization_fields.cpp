@@ -43,6 +43,12 @@ const ResultFields<RelocalizationSummary>& RelocalizationSummaryFields() {
         .Number("update_seconds_mean", &S::update_seconds_mean, "s",
                 "time of one update (AddScan with keypoints given), mean")
         .Number("update_seconds_max", &S::update_seconds_max, "s", "... maximum")
+        .Count("map_searches", &S::map_searches, "searches of the whole map run in the updates")
+        .Number("map_search_seconds_mean", &S::map_search_seconds_mean, "s",
+                "time of one search of the whole map, mean")
+        .Number("update_seconds_mean_without_search", &S::update_seconds_mean_without_search, "s",
+                "time of one update without the searches of the whole map, mean (a robot's "
+                "node runs them on a thread of their own)")
         .Count("lost_signals", &S::lost_signals, "fixes given up (lost)")
         .Count("lost_on_correct_track", &S::lost_on_correct_track, "... while the fix was right")
         .Count("lost_on_wrong_track", &S::lost_on_wrong_track, "... while the fix was wrong");
@@ -83,7 +89,9 @@ const ResultFields<StartRecord>& StartRecordFields() {
         .Integer("lost_on_wrong_track", &R::lost_on_wrong_track, "... while the fix was wrong")
         .Number("update_seconds_mean", &R::update_seconds_mean, "s",
                 "time of one update (AddScan with keypoints given), mean")
-        .Number("update_seconds_max", &R::update_seconds_max, "s", "... maximum");
+        .Number("update_seconds_max", &R::update_seconds_max, "s", "... maximum")
+        .Integer("map_searches", &R::map_searches, "searches of the whole map run in the updates")
+        .Number("map_search_seconds", &R::map_search_seconds, "s", "... the time they took");
     return table;
   }();
   return fields;

@@ -65,6 +65,8 @@ LogRelocalization RelocalizeLog(const GlobalMap& map, const LogInputs& inputs,
     if (progress) progress(k + 1, scans);
   }
   if (scans > 0) run.update_seconds_mean = seconds_sum / static_cast<double>(scans);
+  run.map_searches = relocalizer.map_search().searches();
+  run.map_search_seconds = relocalizer.map_search().search_s();
   return run;
 }
 

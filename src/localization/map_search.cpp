@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -172,7 +173,8 @@ float MapField::Bound(const Offsets& offsets, int x, int y, int level) const {
 }
 
 void MapField::Branch(const std::vector<Offsets>& rotations, Node* nodes, std::size_t count,
-                      int level, float& floor_score, const Visit& visit, long long& scored) const {
+                      int level, float& floor_score, const Visit& visit, long long& scored,
+                      const std::atomic<bool>* stop) const {
   std::sort(nodes, nodes + count, [](const Node& a, const Node& b) {
     return a.bound > b.bound ||
            (a.bound == b.bound && std::tie(a.rotation, a.y, a.x) < std::tie(b.rotation, b.y, b.x));
@@ -180,6 +182,7 @@ void MapField::Branch(const std::vector<Offsets>& rotations, Node* nodes, std::s
   for (std::size_t n = 0; n < count; ++n) {
     const Node& node = nodes[n];
     if (node.bound <= floor_score) return;
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) return;
     if (level == 0) {
       visit(node, floor_score);
       continue;
@@ -197,7 +200,7 @@ void MapField::Branch(const std::vector<Offsets>& rotations, Node* nodes, std::s
         if (child.bound > floor_score) children[kept++] = child;
       }
     }
-    Branch(rotations, children.data(), kept, level - 1, floor_score, visit, scored);
+    Branch(rotations, children.data(), kept, level - 1, floor_score, visit, scored, stop);
   }
 }
 
@@ -223,7 +226,7 @@ bool MapField::Distinct(const Node& a, const Node& b) const {
 }
 
 MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robot, double min_score,
-                                 double min_margin) const {
+                                 double min_margin, const std::atomic<bool>* stop) const {
   MapSearchResult result;
   if (empty() || points_robot.empty()) return result;
   const std::vector<Offsets> rotations = Rotations(points_robot);
@@ -248,8 +251,9 @@ MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robo
         best = node;
         at_least = node.bound;
       },
-      result.nodes);
-  if (!best) return result;
+      result.nodes, stop);
+  const auto stopped = [stop] { return stop != nullptr && stop->load(); };
+  if (!best || stopped()) return result;
   result.score = best->bound;
   const Eigen::Vector2d position = origin_ + cell_m_ * Eigen::Vector2d(best->x, best->y);
   result.T_world_robot =
@@ -268,14 +272,55 @@ MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robo
         rival = node;
         at_least = 2.0F;  // above every bound: the search stops
       },
-      result.nodes);
-  result.found = !rival;
+      result.nodes, stop);
+  result.found = !rival && !stopped();
   result.rival_score = rival ? rival->bound : 0.0;
   return result;
 }
 
-MapSearch::MapSearch(double window_m, double min_margin)
-    : window_m_(window_m), min_margin_(min_margin) {}
+MapSearch::MapSearch(double window_m, double min_margin, bool background)
+    : window_m_(window_m), min_margin_(min_margin), background_(background) {}
+
+MapSearch::MapSearch(const MapSearch& other)
+    : window_m_(other.window_m_),
+      min_margin_(other.min_margin_),
+      background_(other.background_),
+      recent_(other.recent_),
+      last_T_odom_robot_(other.last_T_odom_robot_),
+      odometry_m_(other.odometry_m_),
+      searched_at_m_(other.searched_at_m_),
+      field_(other.field_),
+      field_use_(other.field_use_),
+      field_recognizer_(other.field_recognizer_),
+      searches_(other.searches_),
+      search_s_(other.search_s_) {}
+
+MapSearch& MapSearch::operator=(const MapSearch& other) {
+  if (this == &other) return *this;
+  Cancel();
+  window_m_ = other.window_m_;
+  min_margin_ = other.min_margin_;
+  background_ = other.background_;
+  recent_ = other.recent_;
+  last_T_odom_robot_ = other.last_T_odom_robot_;
+  odometry_m_ = other.odometry_m_;
+  searched_at_m_ = other.searched_at_m_;
+  field_ = other.field_;
+  field_use_ = other.field_use_;
+  field_recognizer_ = other.field_recognizer_;
+  searches_ = other.searches_;
+  search_s_ = other.search_s_;
+  return *this;
+}
+
+MapSearch::~MapSearch() { Cancel(); }
+
+void MapSearch::Cancel() {
+  if (!running_) return;
+  running_->stop->store(true);
+  running_->searched.wait();
+  running_.reset();
+}
 
 void MapSearch::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id) {
   if (window_m_ <= 0.0) return;
@@ -296,6 +341,7 @@ void MapSearch::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int sc
 }
 
 void MapSearch::Reset(bool forget_field) {
+  Cancel();
   recent_.clear();
   last_T_odom_robot_.reset();
   odometry_m_ = 0.0;
@@ -317,56 +363,91 @@ const MapField& MapSearch::FieldFor(const PlaceRecognizer& recognizer,
   return *field_;
 }
 
-std::vector<Eigen::Vector2d> MapSearch::WindowPoints(std::vector<int>& scan_ids) const {
-  const Pose2 T_latest_odom = recent_.back().T_odom_robot.inverse();
+MapSearch::Window MapSearch::CurrentWindow() const {
+  Window window;
+  window.T_odom_newest = recent_.back().T_odom_robot;
+  window.T_odom_oldest = recent_.front().T_odom_robot;
+  window.scans = recent_.size();
+  const Pose2 T_newest_odom = window.T_odom_newest.inverse();
   std::vector<Eigen::Vector2d> points;
   std::unordered_set<std::uint64_t> taken;
   // Newest first: where squares are shared, the newest scan's beam stands for them.
   for (auto it = recent_.rbegin(); it != recent_.rend(); ++it) {
-    const Pose2 T_latest_robot = T_latest_odom * it->T_odom_robot;
+    const Pose2 T_newest_robot = T_newest_odom * it->T_odom_robot;
     for (const Eigen::Vector2d& endpoint : it->endpoints_robot) {
-      const Eigen::Vector2d point = T_latest_robot * endpoint;
+      const Eigen::Vector2d point = T_newest_robot * endpoint;
       if (taken.insert(ThinningKey(point)).second) points.push_back(point);
     }
   }
-  scan_ids.clear();
-  for (const Recent& recent : recent_) scan_ids.push_back(recent.scan_id);
-  if (points.size() <= kMaxPoints) return points;
-  std::vector<Eigen::Vector2d> thinned;
+  for (const Recent& recent : recent_) window.scan_ids.push_back(recent.scan_id);
+  if (points.size() <= kMaxPoints) {
+    window.points_robot = std::move(points);
+    return window;
+  }
   const double stride = static_cast<double>(points.size()) / kMaxPoints;
   for (std::size_t k = 0; k < kMaxPoints; ++k) {
-    thinned.push_back(points[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
+    window.points_robot.push_back(
+        points[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
   }
-  return thinned;
+  return window;
 }
 
 std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recognizer,
                                                     const QueryExclusion& exclusion) {
+  if (running_) {
+    if (running_->searched.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      return std::nullopt;
+    }
+    const Searched searched = running_->searched.get();
+    const Running ended = std::move(*running_);
+    running_.reset();
+    return AnswerOf(searched, ended.window, ended.cell_m);
+  }
   if (window_m_ <= 0.0 || recent_.empty()) return std::nullopt;
   if (odometry_m_ - recent_.front().odometry_m < window_m_) return std::nullopt;
   if (searched_at_m_ && odometry_m_ - *searched_at_m_ < window_m_) return std::nullopt;
   searched_at_m_ = odometry_m_;
 
-  std::vector<int> scan_ids;
-  const std::vector<Eigen::Vector2d> points = WindowPoints(scan_ids);
+  Window window = CurrentWindow();
   std::vector<char> use;
   if (exclusion) {
-    for (const Place& place : recognizer.places()) use.push_back(!exclusion(place, scan_ids));
+    for (const Place& place : recognizer.places()) {
+      use.push_back(!exclusion(place, window.scan_ids));
+    }
   }
-  const MapField& field = FieldFor(recognizer, use);
-  const MapSearchResult found = field.Search(points, kMinScore, min_margin_);
-  if (!found.found) return std::nullopt;
+  FieldFor(recognizer, use);
+  const auto search = [field = field_, points = window.points_robot,
+                       margin = min_margin_](const std::atomic<bool>* stop) {
+    const auto start = std::chrono::steady_clock::now();
+    Searched searched{field->Search(points, kMinScore, margin, stop), 0.0};
+    searched.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return searched;
+  };
+  const double cell_m = field_->cell_m();
+  if (!background_) return AnswerOf(search(nullptr), window, cell_m);
+  const auto stop = std::make_shared<std::atomic<bool>>(false);
+  std::future<Searched> searched =
+      std::async(std::launch::async, [search, stop] { return search(stop.get()); });
+  running_ = Running{std::move(window), cell_m, stop, std::move(searched)};
+  return std::nullopt;
+}
 
+std::optional<LocalizationResult> MapSearch::AnswerOf(const Searched& searched,
+                                                      const Window& window, double cell_m) {
+  ++searches_;
+  search_s_ += searched.seconds;
+  if (!searched.result.found) return std::nullopt;
   LocalizationResult answer;
   answer.found = true;
   // No distinct pose comes within the margin: that margin is what the answer is sure of.
   answer.confidence = min_margin_;
-  answer.T_world_robot = found.T_world_robot;
-  answer.T_world_odom = found.T_world_robot * recent_.back().T_odom_robot.inverse();
-  answer.scans = recent_.size();
-  answer.scan_ids = std::move(scan_ids);
-  answer.T_odom_origin = recent_.front().T_odom_robot;
-  const double cell_m = field.cell_m();
+  answer.T_world_odom = searched.result.T_world_robot * window.T_odom_newest.inverse();
+  answer.T_world_robot = last_T_odom_robot_ ? answer.T_world_odom * *last_T_odom_robot_
+                                            : searched.result.T_world_robot;
+  answer.scans = window.scans;
+  answer.scan_ids = window.scan_ids;
+  answer.T_odom_origin = window.T_odom_oldest;
   const double step_rad = 2.0 * M_PI / kRotations;
   answer.match.estimated_pose_covariance =
       Eigen::Vector3d(cell_m * cell_m, cell_m * cell_m, step_rad * step_rad).asDiagonal();

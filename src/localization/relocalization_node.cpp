@@ -21,7 +21,10 @@ RelocalizationNode::RelocalizationNode(const GlobalMap& map, const Config& confi
         return config;
       }()),
       relocalizer_(map, ToLocalizerConfig(config_), config_.features),
-      sync_(config_.input, config_.node.odometry_wait_s) {}
+      sync_(config_.input, config_.node.odometry_wait_s) {
+  // A search of a large map takes seconds: the robot's scans go on meanwhile.
+  relocalizer_.set_background_search(true);
+}
 
 NodeOutput RelocalizationNode::AddOdometry(const OdometryInput& odometry) {
   NodeOutput output;
@@ -118,8 +121,13 @@ void RelocalizationNode::Publish(const RelocalizationUpdate& update, double stam
   if (update.answer) {
     const LocalizationResult& answer = *update.answer;
     ++status_.answers;
-    status_.last_answer = NodeAnswer{stamp_s,           answer.found,     answer.ambiguous,
-                                     answer.confidence, answer.submap_id, answer.T_world_robot};
+    status_.last_answer = NodeAnswer{stamp_s,
+                                     answer.found,
+                                     answer.ambiguous,
+                                     answer.confidence,
+                                     answer.submap_id,
+                                     update.answer_from_map_search,
+                                     answer.T_world_robot};
     output.status_due = true;
   }
   if (update.lost) {
@@ -180,6 +188,11 @@ NodeStatus RelocalizationNode::status() const {
   status.latency_mean_s = latency.mean_s;
   status.latency_p99_s = latency.p99_s;
   status.latency_max_s = latency.max_s;
+  const MapSearch& search = relocalizer_.map_search();
+  status.map_searches = search.searches();
+  if (search.searches() > 0) {
+    status.map_search_mean_s = search.search_s() / static_cast<double>(search.searches());
+  }
   return status;
 }
 
@@ -203,8 +216,10 @@ std::string RelocalizationNode::StatusYaml() const {
     const NodeAnswer& a = *s.last_answer;
     yaml << "last_answer: {stamp_s: " << a.stamp_s << ", found: " << (a.found ? "true" : "false")
          << ", ambiguous: " << (a.ambiguous ? "true" : "false") << ", confidence: " << a.confidence
-         << ", submap: " << a.submap_id << ", x: " << a.T_world_robot.x
-         << ", y: " << a.T_world_robot.y << ", theta: " << a.T_world_robot.theta << "}\n";
+         << ", submap: " << a.submap_id
+         << ", source: " << (a.map_search ? "map_search" : "keypoints")
+         << ", x: " << a.T_world_robot.x << ", y: " << a.T_world_robot.y
+         << ", theta: " << a.T_world_robot.theta << "}\n";
   }
   yaml << "last_scan_stamp_s: " << s.last_scan_stamp_s << "\n";
   yaml << "scans_received: " << s.scans_received << "\n";
@@ -218,6 +233,8 @@ std::string RelocalizationNode::StatusYaml() const {
   yaml << "latency_mean_s: " << s.latency_mean_s << "\n";
   yaml << "latency_p99_s: " << s.latency_p99_s << "\n";
   yaml << "latency_max_s: " << s.latency_max_s << "\n";
+  yaml << "map_searches: " << s.map_searches << "\n";
+  yaml << "map_search_mean_s: " << s.map_search_mean_s << "\n";
   return yaml.str();
 }
 

@@ -42,10 +42,7 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
   RememberForTrackCheck(scan, T_odom_robot, -1);
   map_search_.AddScan(scan, T_odom_robot, -1);
   localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
-  RelocalizationUpdate update =
-      filter_.Update(AnswerOf(localizer_.AddScan(scan, T_odom_robot)), T_odom_robot);
-  CheckTrack(T_odom_robot, update);
-  return update;
+  return Update(localizer_.AddScan(scan, T_odom_robot), T_odom_robot);
 }
 
 RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_odom_robot,
@@ -53,9 +50,17 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
   RememberForTrackCheck(scan, T_odom_robot, scan_id);
   map_search_.AddScan(scan, T_odom_robot, scan_id);
   localizer_.set_beliefs(filter_.Beliefs(), filter_.status() == FixStatus::kFixed);
-  RelocalizationUpdate update = filter_.Update(
-      AnswerOf(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id)),
-      T_odom_robot);
+  return Update(localizer_.AddScan(scan, T_odom_robot, std::move(keypoints), scan_id),
+                T_odom_robot);
+}
+
+RelocalizationUpdate Relocalizer::Update(std::optional<LocalizationResult> localizer_answer,
+                                         const Pose2& T_odom_robot) {
+  const bool from_localizer = localizer_answer.has_value();
+  std::optional<LocalizationResult> answer = AnswerOf(std::move(localizer_answer));
+  const bool from_map_search = answer.has_value() && !from_localizer;
+  RelocalizationUpdate update = filter_.Update(std::move(answer), T_odom_robot);
+  update.answer_from_map_search = from_map_search;
   CheckTrack(T_odom_robot, update);
   return update;
 }
@@ -64,6 +69,7 @@ std::optional<LocalizationResult> Relocalizer::AnswerOf(
     std::optional<LocalizationResult> localizer_answer) {
   if (filter_.status() == FixStatus::kFixed) {
     map_search_answer_.reset();
+    map_search_.Cancel();
     return localizer_answer;
   }
   if (std::optional<LocalizationResult> found =

@@ -202,6 +202,7 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
   const std::vector<int> starts = QueryStarts(BundledLog().truth, options.starts);
   std::size_t fixed = 0;
   std::size_t fixes = 0;
+  std::size_t searches = 0;
   for (std::size_t i = 0; i < serial.size(); ++i) {
     const StartRecord& s = serial[i];
     const StartRecord& p = parallel[i];
@@ -224,6 +225,7 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
     EXPECT_EQ(p.lost, s.lost) << what;
     EXPECT_EQ(p.lost_on_correct_track, s.lost_on_correct_track) << what;
     EXPECT_EQ(p.lost_on_wrong_track, s.lost_on_wrong_track) << what;
+    EXPECT_EQ(p.map_searches, s.map_searches) << what;
     ASSERT_EQ(p.fixes.size(), s.fixes.size()) << what;
     for (std::size_t f = 0; f < s.fixes.size(); ++f) {
       EXPECT_EQ(p.fixes[f].scan, s.fixes[f].scan) << what;
@@ -235,6 +237,7 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
     }
     fixed += s.fixed ? 1 : 0;
     fixes += s.fixes.size();
+    searches += static_cast<std::size_t>(s.map_searches);
   }
   EXPECT_GE(fixed, 4u);  // starts worth comparing
   EXPECT_GT(fixes, fixed);
@@ -246,6 +249,8 @@ TEST(ParallelRelocalization, StartsAreTheSameAtOneAndTwoThreadsExceptTheirTimes)
   EXPECT_EQ(p.distance_to_fix_median_m, s.distance_to_fix_median_m);
   EXPECT_EQ(p.distance_after_revisit_median_m, s.distance_after_revisit_median_m);
   EXPECT_EQ(p.wrong_fix_confidence_max, s.wrong_fix_confidence_max);
+  EXPECT_EQ(s.map_searches, searches);
+  EXPECT_EQ(p.map_searches, s.map_searches);
 }
 
 }  // namespace

@@ -47,6 +47,27 @@ TEST(RelocalizationSummary, TheFixedFractionWithRoomCountsStartsWithRoomAfterThe
   EXPECT_DOUBLE_EQ(all.fixed_fraction_with_room, all.fixed_fraction);
 }
 
+// The searches of the whole map run within the updates: their time is counted per search and
+// taken out of the updates' mean for what a node (searching in the background) spends per scan.
+TEST(RelocalizationSummary, TheSearchesOfTheWholeMapAreTimedApartFromTheUpdates) {
+  StartRecord searching = StartWith(true, 10.0, false);
+  searching.start_scan = 0;
+  searching.end_scan = 100;
+  searching.update_seconds_mean = 0.012;  // 1.2 s over 100 updates
+  searching.map_searches = 4;
+  searching.map_search_seconds = 1.0;
+  StartRecord fixed_at_once = StartWith(true, 10.0, true);
+  fixed_at_once.start_scan = 200;
+  fixed_at_once.end_scan = 300;
+  fixed_at_once.update_seconds_mean = 0.002;  // 0.2 s, no search
+  const RelocalizationSummary s =
+      SummarizeRelocalization({searching, fixed_at_once}, RelocalizationOptions{});
+  EXPECT_EQ(s.map_searches, 4U);
+  EXPECT_NEAR(s.map_search_seconds_mean, 0.25, 1e-12);
+  EXPECT_NEAR(s.update_seconds_mean, 0.007, 1e-12);
+  EXPECT_NEAR(s.update_seconds_mean_without_search, 0.002, 1e-12);
+}
+
 TEST(RelocalizationOptions, TakeTheRoomFromTheEvaluationSettingsAndRefuseANegativeOne) {
   EvaluationConfig evaluation;
   evaluation.revisit_room_m = 4.0;

@@ -41,9 +41,12 @@ TEST(ResultFields, RelocalizationSummaryFiguresReadTheirOwnMembers) {
   s.starts_with_room = 11;
   s.fixed_with_room = 12;
   s.fixed_fraction_with_room = 0.125;
+  s.map_searches = 13;
+  s.map_search_seconds_mean = 0.375;
+  s.update_seconds_mean_without_search = 0.625;
   const ResultFields<RelocalizationSummary>& fields = RelocalizationSummaryFields();
   ExpectWellFormed(fields, s);
-  EXPECT_EQ(fields.fields().size(), 24u);  // every figure of the struct
+  EXPECT_EQ(fields.fields().size(), 27u);  // every figure of the struct
   EXPECT_EQ(ValueOf(fields, s, "wrong_fixes"), ResultValue(std::int64_t{6}));
   EXPECT_EQ(ValueOf(fields, s, "distance_to_fix_p90_m"), ResultValue(2.5));
   EXPECT_EQ(ValueOf(fields, s, "wrong_fix_confident"), ResultValue(true));
@@ -152,10 +155,12 @@ TEST(ResultFields, StartRecordAndFixEventFiguresReadTheirOwnMembers) {
   r.lost_on_wrong_track = 10;
   r.update_seconds_mean = 2.5;
   r.update_seconds_max = 3.5;
+  r.map_searches = 12;
+  r.map_search_seconds = 4.25;
   // The three other switches stay false: ExpectWellFormed needs one value per figure, so they are
   // checked one by one.
   const ResultFields<StartRecord>& fields = StartRecordFields();
-  EXPECT_EQ(fields.fields().size(), 20u);
+  EXPECT_EQ(fields.fields().size(), 22u);
   EXPECT_EQ(ValueOf(fields, r, "fixes_reported"), ResultValue(std::int64_t{6}));
   EXPECT_EQ(ValueOf(fields, r, "room_after_revisit_m"), ResultValue(4.5));
   EXPECT_EQ(ValueOf(fields, r, "answers_weak"), ResultValue(std::int64_t{11}));

@@ -4,10 +4,13 @@
 #include "keyplace/localization/map_search.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -137,6 +140,79 @@ TEST(MapSearch, FindsWhereTheBeamsFitInAnOpenHall) {
   EXPECT_GE(found, 5);
 }
 
+// Calls Search until a background search has ended and been taken, for at most 60 s.
+std::optional<LocalizationResult> AwaitSearch(MapSearch& search,
+                                              const PlaceRecognizer& recognizer) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (search.searching() && std::chrono::steady_clock::now() < give_up) {
+    if (std::optional<LocalizationResult> answer = search.Search(recognizer, {})) return answer;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return std::nullopt;
+}
+
+// In the background the same searches run and find the same poses: an answer taken two scans
+// after its search began still puts the odometry frame where it is, and the robot where it is
+// now.
+TEST(MapSearch, InTheBackgroundAnswersWithTheScanItIsTakenAt) {
+  const PlaceRecognizer recognizer(PlacesFromMap(HallMap()), PlaceRecognitionConfig{});
+  const SimulatedDrive drive = HallQuery();
+  MapSearch inline_search(5.0, LocalizerConfig{}.map_search_margin);
+  MapSearch background(5.0, LocalizerConfig{}.map_search_margin, true);
+  std::vector<std::size_t> found_inline;
+  std::vector<std::size_t> found_background;
+  std::optional<std::size_t> take_at;
+  for (std::size_t i = 0; i < drive.scans.size(); ++i) {
+    const Pose2 T_odom_robot = kTWorldOdom.inverse() * drive.truth[i];
+    inline_search.AddScan(drive.scans[i], T_odom_robot, static_cast<int>(i));
+    background.AddScan(drive.scans[i], T_odom_robot, static_cast<int>(i));
+    if (const std::optional<LocalizationResult> answer = inline_search.Search(recognizer, {})) {
+      found_inline.push_back(i + 2);
+    }
+    std::optional<LocalizationResult> answer;
+    if (!take_at) {
+      answer = background.Search(recognizer, {});
+      if (background.searching()) take_at = i + 2;
+    } else if (i == *take_at) {
+      answer = AwaitSearch(background, recognizer);
+      take_at.reset();
+    }
+    if (!answer) continue;
+    found_background.push_back(i);
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(Near(answer->T_world_robot, drive.truth[i], 0.3, 3.5));
+    EXPECT_TRUE(Near(answer->T_world_robot, answer->T_world_odom * T_odom_robot, 1e-6, 1e-6));
+    EXPECT_EQ(answer->scan_ids.back() + 2, static_cast<int>(i));
+  }
+  EXPECT_FALSE(background.searching());
+  EXPECT_EQ(background.searches(), inline_search.searches());
+  EXPECT_EQ(found_background, found_inline);
+  EXPECT_GE(found_inline.size(), 5U);
+  EXPECT_GT(background.search_s(), 0.0);
+}
+
+// A search still running is stopped by Reset and not copied: neither waits for it to end.
+TEST(MapSearch, ResetStopsABackgroundSearchAndACopyHasNone) {
+  const PlaceRecognizer recognizer(PlacesFromMap(HallMap()), PlaceRecognitionConfig{});
+  const SimulatedDrive drive = HallQuery();
+  MapSearch search(5.0, LocalizerConfig{}.map_search_margin, true);
+  std::size_t i = 0;
+  for (; i < drive.scans.size() && !search.searching(); ++i) {
+    search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
+    search.Search(recognizer, {});
+  }
+  ASSERT_TRUE(search.searching());
+  const MapSearch copy = search;
+  EXPECT_FALSE(copy.searching());
+  EXPECT_TRUE(copy.background());
+  search.Reset();
+  EXPECT_FALSE(search.searching());
+  // After the reset the window starts again: nothing is due before another 5 m.
+  search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
+  EXPECT_FALSE(search.Search(recognizer, {}).has_value());
+  EXPECT_FALSE(search.searching());
+}
+
 TEST(MapSearch, SaysNothingInOneOfTwoIdenticalRooms) {
   // Round room B, a translated copy of room A: the beams fit both.
   const SimulatedDrive drive =
@@ -208,24 +284,38 @@ TEST(MapSearch, AnEmptyMapOrWindowFindsNothing) {
 
 // Scans whose keypoints say nothing (none given, as where no stable keypoint is seen again): the
 // Relocalizer fixes from the searches alone, and never without them.
+// In the background the answers may come scans later; the robot then stands at its last pose
+// (its scans repeated) for at most 60 s.
 TEST(MapSearch, FixesTheRelocalizerInAnOpenHallWhereKeypointsSayNothing) {
   const SimulatedDrive drive = HallQuery();
-  for (const double window_m : {5.0, 0.0}) {
-    SCOPED_TRACE(window_m);
+  for (const auto& [window_m, background] : {std::pair{5.0, false}, {5.0, true}, {0.0, false}}) {
+    SCOPED_TRACE(::testing::Message() << window_m << (background ? " m, background" : " m"));
     LocalizerConfig config;
     config.map_search_window_m = window_m;
     Relocalizer relocalizer(HallMap(), config);
+    relocalizer.set_background_search(background);
     int fixed = 0;
     int wrong = 0;
-    for (std::size_t i = 0; i < drive.scans.size(); ++i) {
+    int searched_answers = 0;
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    for (std::size_t i = 0; i < drive.scans.size() || (background && fixed == 0 &&
+                                                       std::chrono::steady_clock::now() < give_up);
+         ++i) {
+      const std::size_t at = std::min(i, drive.scans.size() - 1);
       const RelocalizationUpdate update = relocalizer.AddScan(
-          drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], {}, static_cast<int>(i));
+          drive.scans[at], kTWorldOdom.inverse() * drive.truth[at], {}, static_cast<int>(at));
+      // No keypoints given: the queries' answers find nothing; every answer found is a search's,
+      // and says so.
+      const bool found = update.answer && update.answer->found;
+      EXPECT_EQ(update.answer_from_map_search, found);
+      searched_answers += update.answer_from_map_search ? 1 : 0;
       if (update.status != FixStatus::kFixed) continue;
       ++fixed;
-      if (!Near(update.T_world_robot, drive.truth[i], 0.5, 10.0)) ++wrong;
+      if (!Near(update.T_world_robot, drive.truth[at], 0.5, 10.0)) ++wrong;
     }
     EXPECT_EQ(wrong, 0);
     if (window_m > 0.0) {
+      EXPECT_GE(searched_answers, 2);
       EXPECT_GT(fixed, 0);  // two searches, 5 m apart, agree
     } else {
       EXPECT_EQ(fixed, 0);

@@ -88,6 +88,10 @@ struct StartRecord {
   int lost_on_wrong_track = 0;    // "lost" while the fix was wrong (the signal did its job)
   double update_seconds_mean = 0.0;
   double update_seconds_max = 0.0;
+  // Searches of the whole map run within the updates (LocalizerConfig::map_search_window_m) and
+  // the time they took, part of the updates' time.
+  int map_searches = 0;
+  double map_search_seconds = 0.0;
 };
 
 struct RelocalizationSummary {
@@ -115,6 +119,12 @@ struct RelocalizationSummary {
   double distance_after_revisit_p90_m = 0.0;
   double update_seconds_mean = 0.0;  // per AddScan with keypoints given, over all updates
   double update_seconds_max = 0.0;
+  // Searches of the whole map, their mean time, and the updates' mean time without them (what
+  // a robot's node spends per scan: RelocalizationNode runs the searches on a thread of their
+  // own).
+  std::size_t map_searches = 0;
+  double map_search_seconds_mean = 0.0;
+  double update_seconds_mean_without_search = 0.0;
   std::size_t lost_signals = 0;  // the two below, and those with no truth to tell
   std::size_t lost_on_correct_track = 0;
   std::size_t lost_on_wrong_track = 0;

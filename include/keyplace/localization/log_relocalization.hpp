@@ -42,6 +42,9 @@ struct LogRelocalization {
   std::size_t answers = 0;
   double update_seconds_mean = 0.0;
   double update_seconds_max = 0.0;
+  // Searches of the whole map run within the updates, and the time they took (part of theirs).
+  long long map_searches = 0;
+  double map_search_seconds = 0.0;
 };
 
 /// Feeds every scan of `inputs` (its poses are the odometry, its keypoints the scans') to a

@@ -10,10 +10,12 @@
 // look-alike rooms fit several poses nearly as well, and then nothing is said
 // (docs/LOCALIZATION.md, "Search of the whole map").
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <future>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -60,8 +62,9 @@ class MapField {
 
   /// The best pose of points (robot frame) over every turn and cell, and whether a distinct one
   /// comes within min_margin of it. `found` when the best scores above min_score and none does.
+  /// A search whose `stop` is raised ends early and finds nothing.
   MapSearchResult Search(const std::vector<Eigen::Vector2d>& points_robot, double min_score,
-                         double min_margin) const;
+                         double min_margin, const std::atomic<bool>* stop = nullptr) const;
 
   /// The points' mean closeness at a pose, as the search scores its poses (a pose at a cell
   /// centre, turned by a multiple of 2 degrees, scores exactly what the search gives it).
@@ -95,7 +98,8 @@ class MapField {
   float Bound(const Offsets& offsets, int x, int y, int level) const;
   // Depth first, best bound first; boxes not above the floor are pruned.
   void Branch(const std::vector<Offsets>& rotations, Node* nodes, std::size_t count, int level,
-              float& floor_score, const Visit& visit, long long& scored) const;
+              float& floor_score, const Visit& visit, long long& scored,
+              const std::atomic<bool>* stop) const;
   std::vector<Offsets> Rotations(const std::vector<Eigen::Vector2d>& points_robot) const;
   bool Distinct(const Node& a, const Node& b) const;
 
@@ -111,18 +115,42 @@ class MapField {
 /// searched (MapField::Search); a pose found becomes an accepted answer. The field is kept
 /// between searches for the same recognizer and the same places allowed; a recognizer changed
 /// in place (PlaceRecognizer::AddPlace) needs Reset(true).
+///
+/// In the background, a search runs on a thread of its own and its answer comes with the first
+/// call to Search after it ends (one search at a time; the answer's T_world_odom holds whenever
+/// it comes): a robot's scans are not held up by a search of a large map. Otherwise Search
+/// searches before it returns, and the answers depend on the scans alone (replays, tests).
 class MapSearch {
  public:
   /// window_m <= 0: never searches.
-  MapSearch(double window_m, double min_margin);
+  MapSearch(double window_m, double min_margin, bool background = false);
+  /// A copy has the scans and the field, not a search still running.
+  MapSearch(const MapSearch& other);
+  MapSearch& operator=(const MapSearch& other);
+  /// Stops a search still running and waits for its thread.
+  ~MapSearch();
 
   void AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   /// An answer when a search is due and finds a pose (the field of the places `exclusion` allows
-  /// for the window's scan ids; rebuilt only when they change).
+  /// for the window's scan ids; rebuilt only when they change), or, in the background, when a
+  /// search that found one has ended.
   std::optional<LocalizationResult> Search(const PlaceRecognizer& recognizer,
                                            const QueryExclusion& exclusion);
-  /// Forgets the scans and the distance since the last search, and the field with forget_field.
+  /// Forgets the scans, the distance since the last search and a search still running (stopped),
+  /// and the field with forget_field.
   void Reset(bool forget_field = false);
+
+  /// Stops a search still running and drops it unanswered (its answer would be stale when it is
+  /// taken: the Relocalizer got a fix meanwhile).
+  void Cancel();
+
+  void set_background(bool background) { background_ = background; }
+  bool background() const { return background_; }
+  /// A search runs in the background (its answer not yet taken by Search).
+  bool searching() const { return running_.has_value(); }
+  /// Searches run so far and the time they took (on whichever thread ran them).
+  long long searches() const { return searches_; }
+  double search_s() const { return search_s_; }
 
  private:
   struct Recent {
@@ -131,12 +159,33 @@ class MapSearch {
     int scan_id = -1;
     double odometry_m = 0.0;  // path since construction or Reset
   };
+  // What an answer needs besides the search's result: the window it searched.
+  struct Window {
+    std::vector<Eigen::Vector2d> points_robot;  // in the frame of the newest scan
+    std::vector<int> scan_ids;
+    Pose2 T_odom_newest;
+    Pose2 T_odom_oldest;
+    std::size_t scans = 0;
+  };
+  struct Searched {
+    MapSearchResult result;
+    double seconds = 0.0;
+  };
+  // A search on a thread of its own.
+  struct Running {
+    Window window;
+    double cell_m = 0.0;
+    std::shared_ptr<std::atomic<bool>> stop;  // the search's thread holds it too
+    std::future<Searched> searched;
+  };
   const MapField& FieldFor(const PlaceRecognizer& recognizer, const std::vector<char>& use);
-  // The window's beams in the latest scan's frame, thinned, and the window's scan ids.
-  std::vector<Eigen::Vector2d> WindowPoints(std::vector<int>& scan_ids) const;
+  Window CurrentWindow() const;
+  std::optional<LocalizationResult> AnswerOf(const Searched& searched, const Window& window,
+                                             double cell_m);
 
   double window_m_;
   double min_margin_;
+  bool background_;
   std::deque<Recent> recent_;  // scans at least a few cm or degrees apart
   std::optional<Pose2> last_T_odom_robot_;
   double odometry_m_ = 0.0;
@@ -144,6 +193,9 @@ class MapSearch {
   std::shared_ptr<const MapField> field_;
   std::vector<char> field_use_;
   const PlaceRecognizer* field_recognizer_ = nullptr;
+  std::optional<Running> running_;
+  long long searches_ = 0;
+  double search_s_ = 0.0;
 };
 
 }  // namespace keyplace

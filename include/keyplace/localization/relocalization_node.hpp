@@ -41,8 +41,9 @@ struct NodeAnswer {
   bool found = false;
   bool ambiguous = false;
   double confidence = 0.0;
-  int submap_id = -1;
-  Pose2 T_world_robot;  // valid when a candidate was verified
+  int submap_id = -1;       // -1 for an answer of a search of the whole map
+  bool map_search = false;  // the answer came from a search of the whole map
+  Pose2 T_world_robot;      // valid when a candidate was verified
 };
 
 /// What the node reports as its status (a ROS DiagnosticArray, ~save_status).
@@ -65,6 +66,10 @@ struct NodeStatus {
   std::size_t answers = 0;
   std::size_t fixes = 0;   // fixes declared (first ones and new ones after a loss)
   std::size_t losses = 0;  // fixes given up
+  // Searches of the whole map ended (they run on a thread of their own while there is no fix)
+  // and their mean time.
+  long long map_searches = 0;
+  double map_search_mean_s = 0.0;
   // CPU time of processing one scan (keypoints, query, recognition): mean, 99th percentile and
   // maximum over the last kLatencyWindow processed scans.
   double latency_mean_s = 0.0;

@@ -70,6 +70,8 @@ struct RelocalizationUpdate {
   // The localizer's answer when a query submap completed with this scan, or else a search of the
   // whole map's (LocalizerConfig::map_search_window_m; submap_id -1, an empty match).
   std::optional<LocalizationResult> answer;
+  // The answer came from a search of the whole map, not from keypoints.
+  bool answer_from_map_search = false;
   // The answer (accepted, or weak: LocalizationResult::weak_T_world_odom) agreed with the fix
   // (confirmation) or contradicted it.
   bool confirmed = false;
@@ -192,8 +194,14 @@ class Relocalizer {
   void Reset();
 
   void set_exclusion(QueryExclusion exclusion) { localizer_.set_exclusion(std::move(exclusion)); }
+  /// Searches of the whole map (LocalizerConfig::map_search_window_m) run on a thread of their
+  /// own and answer with the first scan after they end (a robot's node: its scans are not held
+  /// up by a search of a large map), or before AddScan returns (the default: a replay's answers
+  /// then depend on its scans alone, not on the machine's speed).
+  void set_background_search(bool background) { map_search_.set_background(background); }
   FixStatus status() const { return filter_.status(); }
   const GlobalLocalizer& localizer() const { return localizer_; }
+  const MapSearch& map_search() const { return map_search_; }
 
  private:
   // The beams the track check needs (none when it is off).
@@ -204,6 +212,9 @@ class Relocalizer {
   // due and the filter has no fix (an answer found on a scan that has the localizer's waits for
   // the next scan without one).
   std::optional<LocalizationResult> AnswerOf(std::optional<LocalizationResult> localizer_answer);
+  // The filter's update with the localizer's answer of this scan (or the search's), checked.
+  RelocalizationUpdate Update(std::optional<LocalizationResult> localizer_answer,
+                              const Pose2& T_odom_robot);
 
   GlobalLocalizer localizer_;
   FixFilter filter_;
