@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <system_error>
 #include <tuple>
 #include <unordered_set>
 #include <utility>
@@ -288,7 +289,8 @@ MapSearch::MapSearch(const MapSearch& other)
       recent_(other.recent_),
       last_T_odom_robot_(other.last_T_odom_robot_),
       odometry_m_(other.odometry_m_),
-      searched_at_m_(other.searched_at_m_),
+      // A search still running is not copied: the copy searches that window again.
+      searched_at_m_(other.running_ ? other.running_->searched_before_m : other.searched_at_m_),
       field_(other.field_),
       field_use_(other.field_use_),
       field_recognizer_(other.field_recognizer_),
@@ -304,7 +306,7 @@ MapSearch& MapSearch::operator=(const MapSearch& other) {
   recent_ = other.recent_;
   last_T_odom_robot_ = other.last_T_odom_robot_;
   odometry_m_ = other.odometry_m_;
-  searched_at_m_ = other.searched_at_m_;
+  searched_at_m_ = other.running_ ? other.running_->searched_before_m : other.searched_at_m_;
   field_ = other.field_;
   field_use_ = other.field_use_;
   field_recognizer_ = other.field_recognizer_;
@@ -318,7 +320,7 @@ MapSearch::~MapSearch() { Cancel(); }
 void MapSearch::Cancel() {
   if (!running_) return;
   running_->stop->store(true);
-  running_->searched.wait();
+  running_->future.wait();
   running_.reset();
 }
 
@@ -394,18 +396,22 @@ MapSearch::Window MapSearch::CurrentWindow() const {
 
 std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recognizer,
                                                     const QueryExclusion& exclusion) {
+  // A search begun for another map (or places) than this call's would answer for the wrong one.
+  if (running_ && &recognizer != field_recognizer_) Cancel();
   if (running_) {
-    if (running_->searched.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    if (running_->future.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
       return std::nullopt;
     }
-    const Searched searched = running_->searched.get();
-    const Running ended = std::move(*running_);
+    // Out of running_ before get(), which rethrows what the search threw: no search is left
+    // running either way.
+    Running ended = std::move(*running_);
     running_.reset();
-    return AnswerOf(searched, ended.window, ended.cell_m);
+    return TakeAnswer(ended.future.get(), ended.window, ended.cell_m);
   }
   if (window_m_ <= 0.0 || recent_.empty()) return std::nullopt;
   if (odometry_m_ - recent_.front().odometry_m < window_m_) return std::nullopt;
   if (searched_at_m_ && odometry_m_ - *searched_at_m_ < window_m_) return std::nullopt;
+  const std::optional<double> searched_before_m = searched_at_m_;
   searched_at_m_ = odometry_m_;
 
   Window window = CurrentWindow();
@@ -419,22 +425,28 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
   const auto search = [field = field_, points = window.points_robot,
                        margin = min_margin_](const std::atomic<bool>* stop) {
     const auto start = std::chrono::steady_clock::now();
-    Searched searched{field->Search(points, kMinScore, margin, stop), 0.0};
-    searched.seconds =
+    Searched result{field->Search(points, kMinScore, margin, stop), 0.0};
+    result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return searched;
+    return result;
   };
   const double cell_m = field_->cell_m();
-  if (!background_) return AnswerOf(search(nullptr), window, cell_m);
-  const auto stop = std::make_shared<std::atomic<bool>>(false);
-  std::future<Searched> searched =
-      std::async(std::launch::async, [search, stop] { return search(stop.get()); });
-  running_ = Running{std::move(window), cell_m, stop, std::move(searched)};
-  return std::nullopt;
+  if (background_) {
+    const auto stop = std::make_shared<std::atomic<bool>>(false);
+    try {
+      std::future<Searched> future =
+          std::async(std::launch::async, [search, stop] { return search(stop.get()); });
+      running_ = Running{std::move(window), cell_m, stop, std::move(future), searched_before_m};
+      return std::nullopt;
+    } catch (const std::system_error&) {
+      // No thread to be had: the search runs here, late rather than never.
+    }
+  }
+  return TakeAnswer(search(nullptr), window, cell_m);
 }
 
-std::optional<LocalizationResult> MapSearch::AnswerOf(const Searched& searched,
-                                                      const Window& window, double cell_m) {
+std::optional<LocalizationResult> MapSearch::TakeAnswer(const Searched& searched,
+                                                        const Window& window, double cell_m) {
   ++searches_;
   search_s_ += searched.seconds;
   if (!searched.result.found) return std::nullopt;

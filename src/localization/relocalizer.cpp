@@ -57,7 +57,7 @@ RelocalizationUpdate Relocalizer::AddScan(const LaserScan& scan, const Pose2& T_
 RelocalizationUpdate Relocalizer::Update(std::optional<LocalizationResult> localizer_answer,
                                          const Pose2& T_odom_robot) {
   const bool from_localizer = localizer_answer.has_value();
-  std::optional<LocalizationResult> answer = AnswerOf(std::move(localizer_answer));
+  std::optional<LocalizationResult> answer = AnswerOf(std::move(localizer_answer), T_odom_robot);
   const bool from_map_search = answer.has_value() && !from_localizer;
   RelocalizationUpdate update = filter_.Update(std::move(answer), T_odom_robot);
   update.answer_from_map_search = from_map_search;
@@ -66,7 +66,7 @@ RelocalizationUpdate Relocalizer::Update(std::optional<LocalizationResult> local
 }
 
 std::optional<LocalizationResult> Relocalizer::AnswerOf(
-    std::optional<LocalizationResult> localizer_answer) {
+    std::optional<LocalizationResult> localizer_answer, const Pose2& T_odom_robot) {
   if (filter_.status() == FixStatus::kFixed) {
     map_search_answer_.reset();
     map_search_.Cancel();
@@ -79,6 +79,8 @@ std::optional<LocalizationResult> Relocalizer::AnswerOf(
   if (localizer_answer) return localizer_answer;
   std::optional<LocalizationResult> answer = std::move(map_search_answer_);
   map_search_answer_.reset();
+  // Held since an earlier scan: the robot is where the map <- odometry correction puts it now.
+  if (answer) answer->T_world_robot = answer->T_world_odom * T_odom_robot;
   return answer;
 }
 

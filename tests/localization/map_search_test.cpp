@@ -4,6 +4,7 @@
 #include "keyplace/localization/map_search.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -181,7 +182,6 @@ TEST(MapSearch, InTheBackgroundAnswersWithTheScanItIsTakenAt) {
     found_background.push_back(i);
     SCOPED_TRACE(i);
     EXPECT_TRUE(Near(answer->T_world_robot, drive.truth[i], 0.3, 3.5));
-    EXPECT_TRUE(Near(answer->T_world_robot, answer->T_world_odom * T_odom_robot, 1e-6, 1e-6));
     EXPECT_EQ(answer->scan_ids.back() + 2, static_cast<int>(i));
   }
   EXPECT_FALSE(background.searching());
@@ -191,8 +191,9 @@ TEST(MapSearch, InTheBackgroundAnswersWithTheScanItIsTakenAt) {
   EXPECT_GT(background.search_s(), 0.0);
 }
 
-// A search still running is stopped by Reset and not copied: neither waits for it to end.
-TEST(MapSearch, ResetStopsABackgroundSearchAndACopyHasNone) {
+// A search still running is stopped by Reset, uncounted, and not copied: the copy searches
+// that window again.
+TEST(MapSearch, ResetStopsABackgroundSearchAndACopySearchesAgain) {
   const PlaceRecognizer recognizer(PlacesFromMap(HallMap()), PlaceRecognitionConfig{});
   const SimulatedDrive drive = HallQuery();
   MapSearch search(5.0, LocalizerConfig{}.map_search_margin, true);
@@ -202,15 +203,38 @@ TEST(MapSearch, ResetStopsABackgroundSearchAndACopyHasNone) {
     search.Search(recognizer, {});
   }
   ASSERT_TRUE(search.searching());
-  const MapSearch copy = search;
+  ASSERT_LT(i, drive.scans.size());
+  MapSearch copy = search;
   EXPECT_FALSE(copy.searching());
   EXPECT_TRUE(copy.background());
+  EXPECT_FALSE(copy.Search(recognizer, {}).has_value());
+  EXPECT_TRUE(copy.searching());  // the same window, due again
   search.Reset();
   EXPECT_FALSE(search.searching());
+  EXPECT_EQ(search.searches(), 0);
   // After the reset the window starts again: nothing is due before another 5 m.
   search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
   EXPECT_FALSE(search.Search(recognizer, {}).has_value());
   EXPECT_FALSE(search.searching());
+}
+
+// A search whose stop is raised finds nothing, where the same search unstopped finds the pose.
+TEST(MapSearch, AStoppedSearchFindsNothing) {
+  const MapField field(PlacesFromMap(HallMap()));
+  const SimulatedDrive drive = HallQuery();
+  std::vector<Eigen::Vector2d> points;
+  for (std::size_t k = 10; k < 15; ++k) {
+    const Pose2 T_latest_robot = Between(drive.truth[14], drive.truth[k]);
+    for (const Eigen::Vector2d& endpoint : DenseScanPoints(drive.scans[k]).endpoints_m) {
+      points.push_back(T_latest_robot * endpoint);
+    }
+  }
+  const double margin = LocalizerConfig{}.map_search_margin;
+  const MapSearchResult found = field.Search(points, 0.5, margin);
+  ASSERT_TRUE(found.found);
+  EXPECT_TRUE(Near(found.T_world_robot, drive.truth[14], 0.3, 3.5));
+  const std::atomic<bool> stop(true);
+  EXPECT_FALSE(field.Search(points, 0.5, margin, &stop).found);
 }
 
 TEST(MapSearch, SaysNothingInOneOfTwoIdenticalRooms) {
@@ -301,6 +325,12 @@ TEST(MapSearch, FixesTheRelocalizerInAnOpenHallWhereKeypointsSayNothing) {
     for (std::size_t i = 0; i < drive.scans.size() || (background && fixed == 0 &&
                                                        std::chrono::steady_clock::now() < give_up);
          ++i) {
+      // A search running ends before the next scan, whatever the machine's speed: the same
+      // windows are searched as inline, their answers taken a scan later.
+      while (relocalizer.map_search().searching() && !relocalizer.map_search().search_ended() &&
+             std::chrono::steady_clock::now() < give_up) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
       const std::size_t at = std::min(i, drive.scans.size() - 1);
       const RelocalizationUpdate update = relocalizer.AddScan(
           drive.scans[at], kTWorldOdom.inverse() * drive.truth[at], {}, static_cast<int>(at));

@@ -139,6 +139,9 @@ TEST(RelocalizationNode, FixesOnTheSecondHalfAndPublishesOneInitialPoseWithItsCo
   EXPECT_LT(TranslationNorm(T_map_odom_error), 0.5);
   ASSERT_TRUE(status.last_answer.has_value());
   EXPECT_GT(status.answers, 1U);
+  // A search's answer names no submap; searches that ended were timed.
+  EXPECT_TRUE(!status.last_answer->map_search || status.last_answer->submap_id == -1);
+  EXPECT_EQ(status.map_searches > 0, status.map_search_mean_s > 0.0);
   EXPECT_EQ(status.scans_dropped, 0U);
   EXPECT_EQ(status.scans_processed, status.scans_received);
   EXPECT_GT(status.latency_mean_s, 0.0);
@@ -382,6 +385,8 @@ TEST(RelocalizationNode, SaveStatusWritesTheStatusAsYaml) {
   testing::ExpectContains(text, "status: fixed\n");
   testing::ExpectContains(text, "pose: {frame_id: map, x: ");
   testing::ExpectContains(text, "fixes: 1\n");
+  testing::ExpectContains(text, "source: ");  // of the last answer: keypoints or a map search
+  testing::ExpectContains(text, "map_searches: ");
   EXPECT_THROW(node.SaveStatus("/nonexistent-dir/status.yaml"), std::runtime_error);
 }
 

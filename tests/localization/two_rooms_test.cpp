@@ -70,7 +70,9 @@ QueryOutcome KidnappedIntoRoomB(const LocalizerConfig& config) {
 }
 
 TEST(TwoRooms, NoFixUntilMotionTellsTheRoomsApartThenTheRightOne) {
-  const QueryOutcome outcome = KidnappedIntoRoomB(LocalizerConfig{});
+  LocalizerConfig config;
+  config.map_search_window_m = 0.0;  // the keypoints' answers alone
+  const QueryOutcome outcome = KidnappedIntoRoomB(config);
   // The rooms did look alike (an answer matched both)...
   EXPECT_GT(outcome.confused_answers, 0);
   // ... so no fix until the corridor told them apart, and then only right ones.
@@ -80,9 +82,7 @@ TEST(TwoRooms, NoFixUntilMotionTellsTheRoomsApartThenTheRightOne) {
 }
 
 TEST(TwoRooms, TheSearchOfTheWholeMapDoesNotFixInOneOfTheRoomsEither) {
-  LocalizerConfig config;
-  config.map_search_window_m = 5.0;  // off by default (docs/LOCALIZATION.md)
-  const QueryOutcome outcome = KidnappedIntoRoomB(config);
+  const QueryOutcome outcome = KidnappedIntoRoomB(LocalizerConfig{});  // the search is on
   EXPECT_EQ(outcome.fixes_in_room, 0);
   EXPECT_GT(outcome.fixes, 0);
   EXPECT_EQ(outcome.wrong_fixes, 0);

@@ -93,9 +93,9 @@ struct LocalizerConfig {
   // While the Relocalizer has no fix it also searches the whole map for the pose where the beams
   // of the scans over the last map_search_window_m of odometry fit (MapSearch), once per that
   // distance; a pose that fits better by map_search_margin (of the mean closeness, 0..1) than
-  // every pose distinct from it is an accepted answer. 0: never. A search costs 0.05-0.26 s on
-  // a map of a floor and 3-5 s on one of 92 x 44 m (docs/LOCALIZATION.md): a robot's node runs it
-  // in the background (Relocalizer::set_background_search).
+  // every pose distinct from it is an accepted answer. 0: never. One search costs up to 0.26 s
+  // on a map of a floor and 2.7-4.7 s on one of 92 x 44 m, on one core (docs/LOCALIZATION.md): a
+  // robot's node runs it in the background (Relocalizer::set_background_search).
   double map_search_window_m = 5.0;
   double map_search_margin = 0.08;
   FixPolicy fix;  // the Relocalizer's

@@ -11,6 +11,7 @@
 // (docs/LOCALIZATION.md, "Search of the whole map").
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -148,7 +149,13 @@ class MapSearch {
   bool background() const { return background_; }
   /// A search runs in the background (its answer not yet taken by Search).
   bool searching() const { return running_.has_value(); }
-  /// Searches run so far and the time they took (on whichever thread ran them).
+  /// A background search has ended: the next call to Search takes its answer.
+  bool search_ended() const {
+    return running_ &&
+           running_->future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+  }
+  /// Searches that ran to their end and were taken, and the time they took (on whichever thread
+  /// ran them); a search stopped by Cancel or Reset is not counted.
   long long searches() const { return searches_; }
   double search_s() const { return search_s_; }
 
@@ -176,12 +183,14 @@ class MapSearch {
     Window window;
     double cell_m = 0.0;
     std::shared_ptr<std::atomic<bool>> stop;  // the search's thread holds it too
-    std::future<Searched> searched;
+    std::future<Searched> future;
+    std::optional<double> searched_before_m;  // searched_at_m_ before this search
   };
   const MapField& FieldFor(const PlaceRecognizer& recognizer, const std::vector<char>& use);
   Window CurrentWindow() const;
-  std::optional<LocalizationResult> AnswerOf(const Searched& searched, const Window& window,
-                                             double cell_m);
+  // Counts the search and makes its answer, if it found a pose.
+  std::optional<LocalizationResult> TakeAnswer(const Searched& searched, const Window& window,
+                                               double cell_m);
 
   double window_m_;
   double min_margin_;

@@ -66,8 +66,8 @@ struct NodeStatus {
   std::size_t answers = 0;
   std::size_t fixes = 0;   // fixes declared (first ones and new ones after a loss)
   std::size_t losses = 0;  // fixes given up
-  // Searches of the whole map ended (they run on a thread of their own while there is no fix)
-  // and their mean time.
+  // Searches of the whole map that ran to their end (on a thread of their own while there is no
+  // fix; one stopped by a fix or ~relocalize is not counted) and their mean time.
   long long map_searches = 0;
   double map_search_mean_s = 0.0;
   // CPU time of processing one scan (keypoints, query, recognition): mean, 99th percentile and

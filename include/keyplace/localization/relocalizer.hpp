@@ -211,7 +211,8 @@ class Relocalizer {
   // The localizer's answer of this scan, or else a search of the whole map's answer, when one is
   // due and the filter has no fix (an answer found on a scan that has the localizer's waits for
   // the next scan without one).
-  std::optional<LocalizationResult> AnswerOf(std::optional<LocalizationResult> localizer_answer);
+  std::optional<LocalizationResult> AnswerOf(std::optional<LocalizationResult> localizer_answer,
+                                             const Pose2& T_odom_robot);
   // The filter's update with the localizer's answer of this scan (or the search's), checked.
   RelocalizationUpdate Update(std::optional<LocalizationResult> localizer_answer,
                               const Pose2& T_odom_robot);
