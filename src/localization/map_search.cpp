@@ -282,46 +282,17 @@ MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robo
 MapSearch::MapSearch(double window_m, double min_margin, bool background)
     : window_m_(window_m), min_margin_(min_margin), background_(background) {}
 
-MapSearch::MapSearch(const MapSearch& other)
-    : window_m_(other.window_m_),
-      min_margin_(other.min_margin_),
-      background_(other.background_),
-      recent_(other.recent_),
-      last_T_odom_robot_(other.last_T_odom_robot_),
-      odometry_m_(other.odometry_m_),
-      // A search still running is not copied: the copy searches that window again.
-      searched_at_m_(other.running_ ? other.running_->searched_before_m : other.searched_at_m_),
-      field_(other.field_),
-      field_use_(other.field_use_),
-      field_recognizer_(other.field_recognizer_),
-      searches_(other.searches_),
-      search_s_(other.search_s_) {}
-
-MapSearch& MapSearch::operator=(const MapSearch& other) {
-  if (this == &other) return *this;
-  Cancel();
-  window_m_ = other.window_m_;
-  min_margin_ = other.min_margin_;
-  background_ = other.background_;
-  recent_ = other.recent_;
-  last_T_odom_robot_ = other.last_T_odom_robot_;
-  odometry_m_ = other.odometry_m_;
-  searched_at_m_ = other.running_ ? other.running_->searched_before_m : other.searched_at_m_;
-  field_ = other.field_;
-  field_use_ = other.field_use_;
-  field_recognizer_ = other.field_recognizer_;
-  searches_ = other.searches_;
-  search_s_ = other.search_s_;
-  return *this;
+void MapSearch::RunningSlot::Stop() {
+  if (!search) return;
+  search->stop->store(true);
+  search->future.wait();
+  search.reset();
 }
 
-MapSearch::~MapSearch() { Cancel(); }
-
 void MapSearch::Cancel() {
-  if (!running_) return;
-  running_->stop->store(true);
-  running_->future.wait();
-  running_.reset();
+  if (!running_.search) return;
+  searched_at_m_ = running_.search->launched_at_m;
+  running_.Stop();
 }
 
 void MapSearch::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id) {
@@ -397,22 +368,19 @@ MapSearch::Window MapSearch::CurrentWindow() const {
 std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recognizer,
                                                     const QueryExclusion& exclusion) {
   // A search begun for another map (or places) than this call's would answer for the wrong one.
-  if (running_ && &recognizer != field_recognizer_) Cancel();
-  if (running_) {
-    if (running_->future.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
-      return std::nullopt;
-    }
-    // Out of running_ before get(), which rethrows what the search threw: no search is left
+  if (running_.search && &recognizer != field_recognizer_) Cancel();
+  if (running_.search) {
+    if (!search_ended()) return std::nullopt;
+    // Out of the slot before get(), which rethrows what the search threw: no search is left
     // running either way.
-    Running ended = std::move(*running_);
-    running_.reset();
+    Running ended = std::move(*running_.search);
+    running_.search.reset();
+    searched_at_m_ = ended.launched_at_m;
     return TakeAnswer(ended.future.get(), ended.window, ended.cell_m);
   }
   if (window_m_ <= 0.0 || recent_.empty()) return std::nullopt;
   if (odometry_m_ - recent_.front().odometry_m < window_m_) return std::nullopt;
   if (searched_at_m_ && odometry_m_ - *searched_at_m_ < window_m_) return std::nullopt;
-  const std::optional<double> searched_before_m = searched_at_m_;
-  searched_at_m_ = odometry_m_;
 
   Window window = CurrentWindow();
   std::vector<char> use;
@@ -436,12 +404,13 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
     try {
       std::future<Searched> future =
           std::async(std::launch::async, [search, stop] { return search(stop.get()); });
-      running_ = Running{std::move(window), cell_m, stop, std::move(future), searched_before_m};
+      running_.search = Running{std::move(window), cell_m, stop, std::move(future), odometry_m_};
       return std::nullopt;
     } catch (const std::system_error&) {
       // No thread to be had: the search runs here, late rather than never.
     }
   }
+  searched_at_m_ = odometry_m_;
   return TakeAnswer(search(nullptr), window, cell_m);
 }
 

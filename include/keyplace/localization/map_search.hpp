@@ -124,12 +124,9 @@ class MapField {
 class MapSearch {
  public:
   /// window_m <= 0: never searches.
+  /// A copy has the scans and the field, not a search still running (it searches that window
+  /// again); destroying or assigning to one stops its search and waits for the thread.
   MapSearch(double window_m, double min_margin, bool background = false);
-  /// A copy has the scans and the field, not a search still running.
-  MapSearch(const MapSearch& other);
-  MapSearch& operator=(const MapSearch& other);
-  /// Stops a search still running and waits for its thread.
-  ~MapSearch();
 
   void AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   /// An answer when a search is due and finds a pose (the field of the places `exclusion` allows
@@ -148,11 +145,11 @@ class MapSearch {
   void set_background(bool background) { background_ = background; }
   bool background() const { return background_; }
   /// A search runs in the background (its answer not yet taken by Search).
-  bool searching() const { return running_.has_value(); }
+  bool searching() const { return running_.search.has_value(); }
   /// A background search has ended: the next call to Search takes its answer.
   bool search_ended() const {
-    return running_ &&
-           running_->future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    return running_.search &&
+           running_.search->future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
   }
   /// Searches that ran to their end and were taken, and the time they took (on whichever thread
   /// ran them); a search stopped by Cancel or Reset is not counted.
@@ -184,7 +181,22 @@ class MapSearch {
     double cell_m = 0.0;
     std::shared_ptr<std::atomic<bool>> stop;  // the search's thread holds it too
     std::future<Searched> future;
-    std::optional<double> searched_before_m;  // searched_at_m_ before this search
+    double launched_at_m = 0.0;  // becomes searched_at_m_ when the search is taken or stopped
+  };
+  // Holds the search running in the background: a copy holds none, and replacing or destroying
+  // the search stops it and waits for its thread.
+  class RunningSlot {
+   public:
+    RunningSlot() = default;
+    RunningSlot(const RunningSlot& /*other*/) {}
+    RunningSlot& operator=(const RunningSlot& other) {
+      if (this != &other) Stop();
+      return *this;
+    }
+    ~RunningSlot() { Stop(); }
+    void Stop();
+
+    std::optional<Running> search;
   };
   const MapField& FieldFor(const PlaceRecognizer& recognizer, const std::vector<char>& use);
   Window CurrentWindow() const;
@@ -202,7 +214,7 @@ class MapSearch {
   std::shared_ptr<const MapField> field_;
   std::vector<char> field_use_;
   const PlaceRecognizer* field_recognizer_ = nullptr;
-  std::optional<Running> running_;
+  RunningSlot running_;
   long long searches_ = 0;
   double search_s_ = 0.0;
 };
