@@ -168,8 +168,9 @@ void BindRelocalizer(py::module_& module) {
           "status is 'fixed').")
       .def_readonly("answer", &RelocalizationUpdate::answer,
                     "The GlobalLocalizer's answer with this scan, or None.")
-      .def_readonly("answer_from_map_search", &RelocalizationUpdate::answer_from_map_search,
-                    "The answer came from a search of the whole map, not from keypoints.")
+      .def_readonly("map_search_answer", &RelocalizationUpdate::map_search_answer,
+                    "The answer of a search of the whole map taken with this scan (judged after "
+                    "`answer`), or None.")
       .def_readonly("confirmed", &RelocalizationUpdate::confirmed)
       .def_readonly("contradicted", &RelocalizationUpdate::contradicted)
       .def_readonly("self_contradicted", &RelocalizationUpdate::self_contradicted,

@@ -163,10 +163,14 @@ class StartRun {
   void Record(const RelocalizationUpdate& update, std::size_t k, double travelled_m) {
     if (update.lost) RecordLost(k);
     if (update.status == FixStatus::kFixed) previous_T_world_odom_ = update.T_world_odom;
-    if (!update.answer) return;
-    ++record_.answers;
-    if (update.answer->found) ++record_.answers_accepted;
-    if (!update.answer->found && update.answer->weak_T_world_odom) ++record_.answers_weak;
+    if (!update.answer && !update.map_search_answer) return;
+    for (const std::optional<LocalizationResult>* answer :
+         {&update.answer, &update.map_search_answer}) {
+      if (!*answer) continue;
+      ++record_.answers;
+      if ((*answer)->found) ++record_.answers_accepted;
+      if (!(*answer)->found && (*answer)->weak_T_world_odom) ++record_.answers_weak;
+    }
     if (update.status != FixStatus::kFixed) return;
     const bool first = !record_.fixed && update.new_fix;
     if (first) {

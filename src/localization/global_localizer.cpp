@@ -46,6 +46,9 @@ void Validate(const LocalizerConfig& config) {
   if (!(config.map_search_window_m >= 0.0) || !std::isfinite(config.map_search_window_m)) {
     throw std::invalid_argument("LocalizerConfig.map_search_window_m must be finite and >= 0");
   }
+  if (!(config.map_search_every_m > 0.0) || !std::isfinite(config.map_search_every_m)) {
+    throw std::invalid_argument("LocalizerConfig.map_search_every_m must be finite and > 0");
+  }
   if (!(config.map_search_margin >= 0.0 && config.map_search_margin <= 1.0)) {
     throw std::invalid_argument("LocalizerConfig.map_search_margin must be in [0, 1]");
   }

@@ -56,8 +56,10 @@ const ConfigFields<LocalizerConfig>& LocalizerConfigFields() {
                 "retrieval words, or auto while a fix is held: queries also pair the places this "
                 "close to where a pending answer or the fix puts the robot (0 = words alone)")
         .Double("map_search_window_m", &C::map_search_window_m, "m",
-                "without a fix, search the whole map with the beams of the scans over this much "
-                "odometry, once per this distance (0 = never)")
+                "without a fix, search the whole map with the beams of the scans over at most this "
+                "much odometry (0 = never) ...")
+        .Double("map_search_every_m", &C::map_search_every_m, "m",
+                "... every time the robot travelled this far")
         .Double("map_search_margin", &C::map_search_margin, "",
                 "... a pose is an answer when its mean closeness beats every distinct pose's by "
                 "this")

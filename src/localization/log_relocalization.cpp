@@ -44,7 +44,7 @@ LogRelocalization RelocalizeLog(const GlobalMap& map, const LogInputs& inputs,
     scan.status = update.status;
     scan.new_fix = update.new_fix;
     scan.lost = update.lost;
-    scan.answered = update.answer.has_value();
+    scan.answered = update.answer.has_value() || update.map_search_answer.has_value();
     if (update.status == FixStatus::kFixed) {
       scan.T_world_robot = update.T_world_robot;
       scan.confidence = update.confidence;

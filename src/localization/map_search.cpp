@@ -279,8 +279,8 @@ MapSearchResult MapField::Search(const std::vector<Eigen::Vector2d>& points_robo
   return result;
 }
 
-MapSearch::MapSearch(double window_m, double min_margin, bool background)
-    : window_m_(window_m), min_margin_(min_margin), background_(background) {}
+MapSearch::MapSearch(double window_m, double every_m, double min_margin, bool background)
+    : window_m_(window_m), every_m_(every_m), min_margin_(min_margin), background_(background) {}
 
 void MapSearch::RunningSlot::Stop() {
   if (!search) return;
@@ -305,7 +305,8 @@ void MapSearch::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int sc
     const Pose2 moved = Between(recent_.back().T_odom_robot, T_odom_robot);
     if (TranslationNorm(moved) < kStillM && std::abs(moved.theta) < kStillRad) return;
   }
-  recent_.push_back({T_odom_robot, DenseScanPoints(scan).endpoints_m, scan_id, odometry_m_});
+  recent_.push_back(
+      {T_odom_robot, DenseScanPoints(scan).endpoints_m, scan_id, odometry_m_, scans_kept_++});
   // Keep the scans of the last window_m, and the one before them: the window spans window_m.
   while (recent_.size() > 2 && odometry_m_ - recent_[1].odometry_m >= window_m_) {
     recent_.pop_front();
@@ -341,6 +342,8 @@ MapSearch::Window MapSearch::CurrentWindow() const {
   window.T_odom_newest = recent_.back().T_odom_robot;
   window.T_odom_oldest = recent_.front().T_odom_robot;
   window.scans = recent_.size();
+  window.first_number = recent_.front().number;
+  window.last_number = recent_.back().number;
   const Pose2 T_newest_odom = window.T_odom_newest.inverse();
   std::vector<Eigen::Vector2d> points;
   std::unordered_set<std::uint64_t> taken;
@@ -379,8 +382,10 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
     return TakeAnswer(ended.future.get(), ended.window, ended.cell_m);
   }
   if (window_m_ <= 0.0 || recent_.empty()) return std::nullopt;
-  if (odometry_m_ - recent_.front().odometry_m < window_m_) return std::nullopt;
-  if (searched_at_m_ && odometry_m_ - *searched_at_m_ < window_m_) return std::nullopt;
+  // The first search as soon as the robot has moved every_m: a window too short to tell places
+  // apart gives no answer (the margin), and one that can should not wait for window_m.
+  if (!searched_at_m_ && odometry_m_ < every_m_) return std::nullopt;
+  if (searched_at_m_ && odometry_m_ - *searched_at_m_ < every_m_) return std::nullopt;
 
   Window window = CurrentWindow();
   std::vector<char> use;
@@ -429,6 +434,8 @@ std::optional<LocalizationResult> MapSearch::TakeAnswer(const Searched& searched
   answer.scans = window.scans;
   answer.scan_ids = window.scan_ids;
   answer.T_odom_origin = window.T_odom_oldest;
+  answer.window_first_scan = window.first_number;
+  answer.window_last_scan = window.last_number;
   const double step_rad = 2.0 * M_PI / kRotations;
   answer.match.estimated_pose_covariance =
       Eigen::Vector3d(cell_m * cell_m, cell_m * cell_m, step_rad * step_rad).asDiagonal();

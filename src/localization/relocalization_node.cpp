@@ -107,7 +107,8 @@ void RelocalizationNode::Process(const LaserScan& scan, const Pose2& T_odom_robo
   AddLatency(latency_s, kLatencyWindow, latencies_s_);
   ++status_.scans_processed;
   status_.last_scan_stamp_s = scan.timestamp_s;
-  output.scans.push_back({scan.timestamp_s, latency_s, update.status, update.answer.has_value()});
+  output.scans.push_back({scan.timestamp_s, latency_s, update.status,
+                          update.answer.has_value() || update.map_search_answer.has_value()});
   Publish(update, scan.timestamp_s, output);
 }
 
@@ -118,16 +119,15 @@ void RelocalizationNode::Publish(const RelocalizationUpdate& update, double stam
   status_.status = update.status;
   status_.confidence = update.status == FixStatus::kFixed ? update.confidence : 0.0;
   status_.unconfirmed_m = update.unconfirmed_m;
-  if (update.answer) {
-    const LocalizationResult& answer = *update.answer;
+  // The search's answer was judged last: it is the last answer.
+  for (const bool map_search : {false, true}) {
+    const std::optional<LocalizationResult>& answer =
+        map_search ? update.map_search_answer : update.answer;
+    if (!answer) continue;
     ++status_.answers;
-    status_.last_answer = NodeAnswer{stamp_s,
-                                     answer.found,
-                                     answer.ambiguous,
-                                     answer.confidence,
-                                     answer.submap_id,
-                                     update.answer_from_map_search,
-                                     answer.T_world_robot};
+    status_.last_answer =
+        NodeAnswer{stamp_s,           answer->found, answer->ambiguous,    answer->confidence,
+                   answer->submap_id, map_search,    answer->T_world_robot};
     output.status_due = true;
   }
   if (update.lost) {

@@ -55,6 +55,30 @@ TEST(FixFilter, OneAnswerIsNotAFixTwoThatAgreeAre) {
   EXPECT_FALSE(update.new_fix);
 }
 
+// Answers of searches of the whole map (LocalizationResult::window_first_scan, window_last_scan)
+// confirm each other only from windows sharing at most one scan: overlapping windows hold the
+// same beams. A keypoint answer confirms either.
+TEST(FixFilter, SearchesOverTheSameScansDoNotConfirmEachOther) {
+  const auto searched = [](long long first_scan, long long last_scan) {
+    LocalizationResult answer = Answer(kTrue);
+    answer.window_first_scan = first_scan;
+    answer.window_last_scan = last_scan;
+    return answer;
+  };
+  FixFilter filter;
+  filter.Update(searched(0, 20), Odometry(20));
+  EXPECT_EQ(filter.Update(searched(4, 24), Odometry(24)).status, FixStatus::kSearching);
+  EXPECT_EQ(filter.Update(searched(19, 39), Odometry(39)).status, FixStatus::kSearching);
+  // Sharing the boundary scan only with the first: two looks.
+  const RelocalizationUpdate update = filter.Update(searched(20, 40), Odometry(40));
+  EXPECT_EQ(update.status, FixStatus::kFixed);
+  EXPECT_TRUE(update.new_fix);
+
+  filter.Reset();
+  filter.Update(searched(0, 20), Odometry(20));
+  EXPECT_EQ(filter.Update(Answer(kTrue), Odometry(21)).status, FixStatus::kFixed);
+}
+
 // What the Relocalizer tells its localizer to search near (LocalizerConfig::search_near_m): every
 // answer held while searching, then the fix and the answers challenging it.
 TEST(FixFilter, BeliefsAreTheAnswersHeldAndTheFix) {

@@ -78,7 +78,7 @@ struct StartRecord {
   double distance_to_fix_m = 0.0;
   bool first_fix_checked = false;  // a truth pose was near enough to check it
   bool first_fix_correct = false;
-  int answers = 0;           // queries answered
+  int answers = 0;           // answers: queries answered and searches of the whole map found
   int answers_accepted = 0;  // of them accepted by the place recognizer
   int answers_weak = 0;      // of them not accepted but naming a weak answer
   std::vector<FixEvent> fixes;

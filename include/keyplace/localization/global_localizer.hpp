@@ -91,12 +91,14 @@ struct LocalizerConfig {
   // belief is not left to the words. 0: the words alone.
   double search_near_m = 3.0;
   // While the Relocalizer has no fix it also searches the whole map for the pose where the beams
-  // of the scans over the last map_search_window_m of odometry fit (MapSearch), once per that
-  // distance; a pose that fits better by map_search_margin (of the mean closeness, 0..1) than
-  // every pose distinct from it is an accepted answer. 0: never. One search costs up to 0.26 s
-  // on a map of a floor and 2.7-4.7 s on one of 92 x 44 m, on one core (docs/LOCALIZATION.md): a
-  // robot's node runs it in the background (Relocalizer::set_background_search).
+  // of the scans over the last map_search_window_m of odometry (at most) fit (MapSearch), every
+  // map_search_every_m of odometry; a pose that fits better by map_search_margin (of the mean
+  // closeness, 0..1) than every pose distinct from it is an accepted answer. Window 0: never. One
+  // search costs up to 0.26 s on a map of a floor and 2.7-4.7 s on one of 92 x 44 m, on one core
+  // (docs/LOCALIZATION.md): a robot's node runs it in the background
+  // (Relocalizer::set_background_search).
   double map_search_window_m = 5.0;
+  double map_search_every_m = 1.0;
   double map_search_margin = 0.08;
   FixPolicy fix;  // the Relocalizer's
 };
@@ -121,6 +123,12 @@ struct LocalizationResult {
   // Answers with the same id came from one query (LocalizerConfig::query_every_m) and share
   // scans, so they are not independent evidence; -1: independent of every other answer.
   long long query_id = -1;
+  // An answer of a search of the whole map (MapSearch): the first and the last scan of the window
+  // it searched, numbered in the order the search kept them (a robot standing still adds none).
+  // Two such answers whose windows share more than one scan are not independent either. -1: not
+  // a search's answer.
+  long long window_first_scan = -1;
+  long long window_last_scan = -1;
   // When the match was not accepted but names a weak answer (PlaceMatch::weak, its confidence
   // match.weak_confidence): the map <- odometry correction of that pose. Alone it is no fix; the
   // Relocalizer adds such answers up (docs/LOCALIZATION.md, "Weak answers").

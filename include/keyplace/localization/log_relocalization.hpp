@@ -26,7 +26,7 @@ struct RelocalizedScan {
   FixStatus status = FixStatus::kSearching;
   bool new_fix = false;
   bool lost = false;
-  bool answered = false;  // a query completed with this scan (an answer, found or not)
+  bool answered = false;  // an answer came with this scan (a query's, found or not, or a search's)
   Pose2 T_world_robot;    // valid when status is kFixed
   double confidence = 0.0;
   double update_seconds = 0.0;  // wall time of the Relocalizer's AddScan

@@ -112,8 +112,8 @@ class MapField {
 };
 
 /// Feeds the Relocalizer answers from searches of the whole map while it has no fix: every
-/// `window_m` of odometry, the beams of the scans over the last window_m (DenseScanPoints) are
-/// searched (MapField::Search); a pose found becomes an accepted answer. The field is kept
+/// `every_m` of odometry, the beams of the scans over the last window_m at most (DenseScanPoints)
+/// are searched (MapField::Search); a pose found becomes an accepted answer. The field is kept
 /// between searches for the same recognizer and the same places allowed; a recognizer changed
 /// in place (PlaceRecognizer::AddPlace) needs Reset(true).
 ///
@@ -123,10 +123,10 @@ class MapField {
 /// searches before it returns, and the answers depend on the scans alone (replays, tests).
 class MapSearch {
  public:
-  /// window_m <= 0: never searches.
+  /// window_m <= 0: never searches; every_m > 0.
   /// A copy has the scans and the field, not a search still running (it searches that window
   /// again); destroying or assigning to one stops its search and waits for the thread.
-  MapSearch(double window_m, double min_margin, bool background = false);
+  MapSearch(double window_m, double every_m, double min_margin, bool background = false);
 
   void AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   /// An answer when a search is due and finds a pose (the field of the places `exclusion` allows
@@ -162,6 +162,7 @@ class MapSearch {
     std::vector<Eigen::Vector2d> endpoints_robot;
     int scan_id = -1;
     double odometry_m = 0.0;  // path since construction or Reset
+    long long number = 0;     // scans_kept_ when it was kept
   };
   // What an answer needs besides the search's result: the window it searched.
   struct Window {
@@ -170,6 +171,8 @@ class MapSearch {
     Pose2 T_odom_newest;
     Pose2 T_odom_oldest;
     std::size_t scans = 0;
+    long long first_number = 0;
+    long long last_number = 0;
   };
   struct Searched {
     MapSearchResult result;
@@ -205,6 +208,7 @@ class MapSearch {
                                                double cell_m);
 
   double window_m_;
+  double every_m_;
   double min_margin_;
   bool background_;
   std::deque<Recent> recent_;  // scans at least a few cm or degrees apart
@@ -216,6 +220,9 @@ class MapSearch {
   const PlaceRecognizer* field_recognizer_ = nullptr;
   RunningSlot running_;
   long long searches_ = 0;
+  // Numbers the scans kept; not reset, so that answers given before a Reset never seem to share
+  // a later window's scans.
+  long long scans_kept_ = 0;
   double search_s_ = 0.0;
 };
 

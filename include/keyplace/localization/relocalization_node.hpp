@@ -82,7 +82,7 @@ struct ProcessedScan {
   double stamp_s = 0.0;
   double latency_s = 0.0;  // CPU time the node spent on it
   FixStatus status = FixStatus::kSearching;
-  bool answered = false;  // a query completed with it
+  bool answered = false;  // an answer came with it (a query's or a search's)
 };
 
 /// What to publish after one call, in this order.

@@ -67,11 +67,12 @@ struct RelocalizationUpdate {
   // odometry) plus the same drift allowance as the variances above, plus the map's own error
   // (FixPolicy::map_sigma_m, map_sigma_deg). What /initialpose gets.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  // The localizer's answer when a query submap completed with this scan, or else a search of the
-  // whole map's (LocalizerConfig::map_search_window_m; submap_id -1, an empty match).
+  // The localizer's answer when a query submap completed with this scan.
   std::optional<LocalizationResult> answer;
-  // The answer came from a search of the whole map, not from keypoints.
-  bool answer_from_map_search = false;
+  // The answer of a search of the whole map taken with this scan (LocalizerConfig::
+  // map_search_window_m; submap_id -1, an empty match), judged after `answer`; dropped (none
+  // here) when `answer` made a fix.
+  std::optional<LocalizationResult> map_search_answer;
   // The answer (accepted, or weak: LocalizationResult::weak_T_world_odom) agreed with the fix
   // (confirmation) or contradicted it.
   bool confirmed = false;
@@ -86,15 +87,17 @@ struct RelocalizationUpdate {
   bool track_misfit = false;
 };
 
-/// The temporal part alone: turns a stream of answers (one per scan, most of them none) into
-/// fixes, confirmations and losses. Relocalizer feeds it the GlobalLocalizer's answers; tests
+/// The temporal part alone: turns a stream of answers (most scans have none) into fixes,
+/// confirmations and losses. Relocalizer feeds it the GlobalLocalizer's answers; tests
 /// and other front ends can feed it their own.
 class FixFilter {
  public:
   /// Throws std::invalid_argument for an invalid policy (naming the field).
   explicit FixFilter(const FixPolicy& policy = {});
 
-  /// The next scan: its odometry pose and the answer that came with it, if any.
+  /// The next scan: its odometry pose and the answer that came with it, if any. A scan with two
+  /// answers (the Relocalizer's keypoints and search) is two calls with the same pose: the
+  /// second adds no odometry.
   RelocalizationUpdate Update(std::optional<LocalizationResult> answer, const Pose2& T_odom_robot);
 
   void Reset();
@@ -118,8 +121,10 @@ class FixFilter {
     // Covariance of the robot's pose in the map at T_odom_robot, from the match.
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     Pose2 T_odom_robot;
-    long long query_id = -1;  // LocalizationResult::query_id
-    bool weak = false;        // a weak answer (LocalizationResult::weak_T_world_odom)
+    long long query_id = -1;           // LocalizationResult::query_id
+    bool weak = false;                 // a weak answer (LocalizationResult::weak_T_world_odom)
+    long long window_first_scan = -1;  // LocalizationResult::window_first_scan, window_last_scan
+    long long window_last_scan = -1;
   };
   // The hypothesis an answer names: its accepted match, or else its weak answer.
   Hypothesis HypothesisOf(const LocalizationResult& answer, const Pose2& T_odom_robot) const;
@@ -131,6 +136,9 @@ class FixFilter {
   bool Enough(const std::vector<Hypothesis>& agreeing, const Hypothesis& latest) const;
   // Whether two hypotheses name the same robot pose now, within the policy's tolerances.
   bool Agree(const Hypothesis& a, const Hypothesis& b, const Pose2& T_odom_robot) const;
+  // Both are answers of searches of the whole map whose windows share more than one scan: the
+  // same beams, not two looks.
+  static bool ShareSearchedScans(const Hypothesis& a, const Hypothesis& b);
   // What an answer does to the earlier answers of its query in the pools.
   enum class OwnQuery {
     kReplaces,      // they are dropped; the answer counts in their place
@@ -208,12 +216,11 @@ class Relocalizer {
   void RememberForTrackCheck(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id);
   // The track check of FixPolicy::track_check_every_m, on `update` of the scan just added.
   void CheckTrack(const Pose2& T_odom_robot, RelocalizationUpdate& update);
-  // The localizer's answer of this scan, or else a search of the whole map's answer, when one is
-  // due and the filter has no fix (an answer found on a scan that has the localizer's waits for
-  // the next scan without one).
-  std::optional<LocalizationResult> AnswerOf(std::optional<LocalizationResult> localizer_answer,
-                                             const Pose2& T_odom_robot);
-  // The filter's update with the localizer's answer of this scan (or the search's), checked.
+  // The answer of a search of the whole map taken with this scan, when the filter has no fix
+  // (MapSearch::Search: one is due, or one running in the background ended); a fix stops a
+  // running search.
+  std::optional<LocalizationResult> MapSearchAnswer();
+  // The filter's update with the localizer's answer of this scan and then the search's, checked.
   RelocalizationUpdate Update(std::optional<LocalizationResult> localizer_answer,
                               const Pose2& T_odom_robot);
 
@@ -221,7 +228,6 @@ class Relocalizer {
   FixFilter filter_;
   TrackCheck track_;
   MapSearch map_search_;
-  std::optional<LocalizationResult> map_search_answer_;  // waiting for a scan without an answer
   std::optional<Pose2> last_T_odom_robot_;
   double since_check_m_ = 0.0;  // odometry since the fix or its last check
 };
