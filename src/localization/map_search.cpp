@@ -382,10 +382,9 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
     return TakeAnswer(ended.future.get(), ended.window, ended.cell_m);
   }
   if (window_m_ <= 0.0 || recent_.empty()) return std::nullopt;
-  // The first search as soon as the robot has moved every_m: a window too short to tell places
-  // apart gives no answer (the margin), and one that can should not wait for window_m.
-  if (!searched_at_m_ && odometry_m_ < every_m_) return std::nullopt;
-  if (searched_at_m_ && odometry_m_ - *searched_at_m_ < every_m_) return std::nullopt;
+  // Every every_m, the first as soon as the robot has moved every_m: a window too short to tell
+  // places apart gives no answer (the margin), and one that can should not wait for window_m.
+  if (odometry_m_ - searched_at_m_.value_or(0.0) < every_m_) return std::nullopt;
 
   Window window = CurrentWindow();
   std::vector<char> use;
