@@ -22,6 +22,9 @@ bool CellIndexOf(double coordinate_m, double cell_size_m, int& index) {
   return true;
 }
 
+// floor(cell / side) for any sign of cell.
+int TileOf(int cell, int side) { return cell >= 0 ? cell / side : -((-cell - 1) / side) - 1; }
+
 std::string PointText(const Eigen::Vector2d& point_m) {
   std::ostringstream text;
   text << "(" << point_m.x() << ", " << point_m.y() << ")";
@@ -37,7 +40,8 @@ StabilityGrid::StabilityGrid(const MappingConfig& config)
 
 void StabilityGrid::Clear() {
   origin_i_ = origin_j_ = width_ = height_ = 0;
-  counts_.clear();
+  tile_origin_i_ = tile_origin_j_ = tiles_wide_ = tiles_high_ = 0;
+  tiles_.clear();
   hit_cells_ = observed_cells_ = 0;
   newly_hit_cells_.clear();
   keypoints_.clear();
@@ -69,13 +73,37 @@ Eigen::Vector2d StabilityGrid::CellCenter(const CellIndex& cell) const {
 }
 
 CellCounts StabilityGrid::Counts(const CellIndex& cell) const {
-  if (!Allocated(cell.i, cell.j)) return {};
-  return counts_[static_cast<std::size_t>(cell.j - origin_j_) * static_cast<std::size_t>(width_) +
-                 static_cast<std::size_t>(cell.i - origin_i_)];
+  if (!InBox(cell.i, cell.j)) return {};
+  const CellCounts* counts = Find(cell.i, cell.j);
+  return counts != nullptr ? *counts : CellCounts{};
+}
+
+std::size_t StabilityGrid::TileSlot(int i, int j) const {
+  return static_cast<std::size_t>(TileOf(j, kTileSide) - tile_origin_j_) *
+             static_cast<std::size_t>(tiles_wide_) +
+         static_cast<std::size_t>(TileOf(i, kTileSide) - tile_origin_i_);
+}
+
+std::size_t StabilityGrid::WithinTile(int i, int j) {
+  const int column = i - TileOf(i, kTileSide) * kTileSide;
+  const int row = j - TileOf(j, kTileSide) * kTileSide;
+  return static_cast<std::size_t>(row) * kTileSide + static_cast<std::size_t>(column);
+}
+
+const CellCounts* StabilityGrid::Find(int i, int j) const {
+  const std::vector<CellCounts>& tile = tiles_[TileSlot(i, j)];
+  if (tile.empty()) return nullptr;
+  return &tile[WithinTile(i, j)];
+}
+
+CellCounts& StabilityGrid::At(int i, int j) {
+  std::vector<CellCounts>& tile = tiles_[TileSlot(i, j)];
+  if (tile.empty()) tile.resize(kTileCells);
+  return tile[WithinTile(i, j)];
 }
 
 std::int64_t StabilityGrid::CellsToCover(const CellIndex& min, const CellIndex& max) const {
-  if (width_ > 0 && Allocated(min.i, min.j) && Allocated(max.i, max.j)) {
+  if (width_ > 0 && InBox(min.i, min.j) && InBox(max.i, max.j)) {
     return allocated_cell_count();
   }
   // As EnsureCovers, in 64 bits (indices lie within +-kMaxCellIndex, so nothing overflows).
@@ -93,7 +121,7 @@ std::int64_t StabilityGrid::CellsToCover(const CellIndex& min, const CellIndex& 
 }
 
 void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
-  if (width_ > 0 && Allocated(min_i, min_j) && Allocated(max_i, max_j)) return;
+  if (width_ > 0 && InBox(min_i, min_j) && InBox(max_i, max_j)) return;
   int new_min_i = min_i - kGrowthMarginCells;
   int new_min_j = min_j - kGrowthMarginCells;
   int new_max_i = max_i + kGrowthMarginCells;
@@ -104,25 +132,40 @@ void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
     new_max_i = std::max(new_max_i, origin_i_ + width_ - 1);
     new_max_j = std::max(new_max_j, origin_j_ + height_ - 1);
   }
-  const int new_width = new_max_i - new_min_i + 1;
-  const int new_height = new_max_j - new_min_j + 1;
-  std::vector<CellCounts> grown(static_cast<std::size_t>(new_width) * new_height);
-  for (int j = 0; j < height_; ++j) {
-    const int target_row = j + origin_j_ - new_min_j;
-    std::copy_n(counts_.begin() + static_cast<std::ptrdiff_t>(j) * width_, width_,
-                grown.begin() + static_cast<std::ptrdiff_t>(target_row) * new_width +
-                    (origin_i_ - new_min_i));
+  // The tile index first: nothing changes if its allocation throws.
+  const int tile_min_i = TileOf(new_min_i, kTileSide);
+  const int tile_min_j = TileOf(new_min_j, kTileSide);
+  const int tiles_wide = TileOf(new_max_i, kTileSide) - tile_min_i + 1;
+  const int tiles_high = TileOf(new_max_j, kTileSide) - tile_min_j + 1;
+  if (tile_min_i != tile_origin_i_ || tile_min_j != tile_origin_j_ || tiles_wide != tiles_wide_ ||
+      tiles_high != tiles_high_) {
+    std::vector<std::vector<CellCounts>> grown(static_cast<std::size_t>(tiles_wide) *
+                                               static_cast<std::size_t>(tiles_high));
+    for (int tj = 0; tj < tiles_high_; ++tj) {
+      for (int ti = 0; ti < tiles_wide_; ++ti) {
+        const auto target = static_cast<std::size_t>(tj + tile_origin_j_ - tile_min_j) *
+                                static_cast<std::size_t>(tiles_wide) +
+                            static_cast<std::size_t>(ti + tile_origin_i_ - tile_min_i);
+        grown[target] =
+            std::move(tiles_[static_cast<std::size_t>(tj) * static_cast<std::size_t>(tiles_wide_) +
+                             static_cast<std::size_t>(ti)]);
+      }
+    }
+    tiles_ = std::move(grown);
+    tile_origin_i_ = tile_min_i;
+    tile_origin_j_ = tile_min_j;
+    tiles_wide_ = tiles_wide;
+    tiles_high_ = tiles_high;
   }
-  counts_ = std::move(grown);
   origin_i_ = new_min_i;
   origin_j_ = new_min_j;
-  width_ = new_width;
-  height_ = new_height;
+  width_ = new_max_i - new_min_i + 1;
+  height_ = new_max_j - new_min_j + 1;
 }
 
 void StabilityGrid::AddMiss(int i, int j, int scan_id) {
   // Rounding can step the traversal one cell past the endpoint's; never outside the counters.
-  if (!Allocated(i, j)) return;
+  if (!InBox(i, j)) return;
   CellCounts& cell = At(i, j);
   if (config_.density_counting == MappingConfig::DensityCounting::kScans) {
     // Once per scan, and not at all when this scan also ends a beam in the cell (the hits of a
@@ -286,28 +329,40 @@ std::vector<std::vector<GridKeypoint>> StabilityGrid::Clusters(const CellIndex& 
   return clusters;
 }
 
-std::vector<CellIndex> StabilityGrid::HitCells() const {
-  std::vector<CellIndex> cells;
-  cells.reserve(static_cast<std::size_t>(hit_cells_));
-  for (int j = 0; j < height_; ++j) {
-    for (int i = 0; i < width_; ++i) {
-      if (counts_[static_cast<std::size_t>(j) * width_ + i].hits > 0) {
-        cells.push_back({i + origin_i_, j + origin_j_});
+template <typename Visit>
+void StabilityGrid::ForEachTiledCell(const Visit& visit) const {
+  for (int tj = 0; tj < tiles_high_; ++tj) {
+    for (int row = 0; row < kTileSide; ++row) {
+      const int j = (tile_origin_j_ + tj) * kTileSide + row;
+      for (int ti = 0; ti < tiles_wide_; ++ti) {
+        const std::vector<CellCounts>& tile =
+            tiles_[static_cast<std::size_t>(tj) * static_cast<std::size_t>(tiles_wide_) +
+                   static_cast<std::size_t>(ti)];
+        if (tile.empty()) continue;
+        for (int column = 0; column < kTileSide; ++column) {
+          visit((tile_origin_i_ + ti) * kTileSide + column, j,
+                tile[static_cast<std::size_t>(row) * kTileSide + static_cast<std::size_t>(column)]);
+        }
       }
     }
   }
+}
+
+std::vector<CellIndex> StabilityGrid::HitCells() const {
+  std::vector<CellIndex> cells;
+  cells.reserve(static_cast<std::size_t>(hit_cells_));
+  ForEachTiledCell([&cells](int i, int j, const CellCounts& counts) {
+    if (counts.hits > 0) cells.push_back({i, j});
+  });
   return cells;
 }
 
 std::vector<CellIndex> StabilityGrid::ObservedCells() const {
   std::vector<CellIndex> cells;
   cells.reserve(static_cast<std::size_t>(observed_cells_));
-  for (int j = 0; j < height_; ++j) {
-    for (int i = 0; i < width_; ++i) {
-      const CellCounts& counts = counts_[static_cast<std::size_t>(j) * width_ + i];
-      if (counts.hits > 0 || counts.misses > 0) cells.push_back({i + origin_i_, j + origin_j_});
-    }
-  }
+  ForEachTiledCell([&cells](int i, int j, const CellCounts& counts) {
+    if (counts.hits > 0 || counts.misses > 0) cells.push_back({i, j});
+  });
   return cells;
 }
 

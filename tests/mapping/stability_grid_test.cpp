@@ -75,6 +75,43 @@ TEST(StabilityGrid, ObservedCellsAreTheCrossedAndHitCells) {
   EXPECT_EQ(grid.HitCells().size(), 2u);
 }
 
+// The counters are allocated in tiles where beams pass; each cell keeps its own, on both sides of
+// zero, across the grid's growth (beams of 150 cells outgrow its margin of 64), and the observed
+// cells come row by row whatever the tiles.
+TEST(StabilityGrid, EveryCellKeepsItsOwnCountersAcrossTilesAndGrowth) {
+  StabilityGrid grid(UnitCells());
+  grid.InsertRays({0.5, 0.5}, {{150.5, 0.5}}, 0);   // cells 1 .. 149 crossed, 150 hit
+  grid.InsertRays({0.5, 0.5}, {{-149.5, 0.5}}, 1);  // cells -1 .. -149 crossed, -150 hit
+  grid.InsertRays({0.5, 0.5}, {{0.5, -99.5}, {0.5, 120.5}}, 2);
+  EXPECT_GE(grid.allocated_cell_count(), 300 * 220);
+  for (const int i : {-150, 150}) EXPECT_EQ(grid.Counts({i, 0}).hits, 1) << i;
+  for (const int i : {-149, -17, -16, -15, -1, 1, 15, 16, 17, 149}) {
+    EXPECT_EQ(grid.Counts({i, 0}).misses, 1) << i;
+    EXPECT_EQ(grid.Counts({i, 0}).hits, 0) << i;
+  }
+  EXPECT_EQ(grid.Counts({0, 0}).misses, 4);  // every beam leaves from it
+  for (const int j : {-100, 120}) EXPECT_EQ(grid.Counts({0, j}).hits, 1) << j;
+  for (const int j : {-99, -16, -1, 1, 16, 119}) EXPECT_EQ(grid.Counts({0, j}).misses, 1) << j;
+  EXPECT_EQ(grid.Counts({1, 1}).misses + grid.Counts({-1, -1}).misses, 0);
+  EXPECT_EQ(grid.Counts({-150, 1}).hits + grid.Counts({1, 120}).hits, 0);
+
+  const std::vector<CellIndex> observed = grid.ObservedCells();
+  EXPECT_EQ(static_cast<std::int64_t>(observed.size()), grid.observed_cell_count());
+  EXPECT_EQ(observed.size(), std::size_t{301 + 100 + 120});
+  for (std::size_t k = 1; k < observed.size(); ++k) {
+    const bool row_by_row =
+        observed[k - 1].j < observed[k].j ||
+        (observed[k - 1].j == observed[k].j && observed[k - 1].i < observed[k].i);
+    EXPECT_TRUE(row_by_row) << k;
+  }
+  const std::vector<CellIndex> hits = grid.HitCells();
+  ASSERT_EQ(hits.size(), 4u);
+  EXPECT_EQ(hits[0].j, -100);
+  EXPECT_EQ(hits[1].i, -150);
+  EXPECT_EQ(hits[2].i, 150);
+  EXPECT_EQ(hits[3].j, 120);
+}
+
 TEST(StabilityGrid, DiagonalRayVisitsCellsInCrossingOrder) {
   StabilityGrid grid(UnitCells());
   // From (0.5, 0.5) to (2.5, 1.5): crosses x = 1 at t = 0.25, y = 1 at t = 0.5, x = 2 at 0.75.

@@ -56,12 +56,13 @@ struct MappingConfig {
   // scans is closed anyway and flagged `forced` (0 = never; then Algorithm 2 stops at the first
   // submap that cannot be completed, as in the paper).
   int max_scans_per_submap = 300;
-  // Safety net absent from the paper, bounding memory: the dense counters of G span the bounding
-  // box of the submap's beams (plus a margin), sizeof(CellCounts) = 20 bytes per cell. A scan
-  // that would grow them beyond this many cells (a pose jump: an odometry glitch) closes the
-  // submap instead: its pose is kept, its beams and keypoints are not inserted, and the submap
-  // is flagged `forced`. A single scan that needs more on its own is an error. See
-  // docs/MAPPING.md. The default, 2^24 cells (320 MiB), holds 400 m x 400 m at l_g = 0.1 m.
+  // Safety net absent from the paper, bounding memory: G spans the bounding box of the submap's
+  // beams (plus a margin); its counters, sizeof(CellCounts) = 20 bytes per cell, are allocated
+  // in tiles of 16 x 16 cells where beams pass, so the box bounds them. A scan that would grow
+  // the box beyond this many cells (a pose jump: an odometry glitch) closes the submap instead:
+  // its pose is kept, its beams and keypoints are not inserted, and the submap is flagged
+  // `forced`. A single scan that needs more on its own is an error. See docs/MAPPING.md. The
+  // default, 2^24 cells (at most 320 MiB of counters), holds 400 m x 400 m at l_g = 0.1 m.
   std::int64_t max_grid_cells = std::int64_t{1} << 24;
 };
 

@@ -79,11 +79,12 @@ class StabilityGrid {
   CellIndex CellOf(const Eigen::Vector2d& point_m) const;
   Eigen::Vector2d CellCenter(const CellIndex& cell) const;
 
-  /// Cells the dense counters would hold once grown to cover every cell from `min` to `max`
-  /// (inclusive), as InsertRays grows them (with a margin). The current count when they already
-  /// cover it.
+  /// Cells of the grid's bounding box once grown to cover every cell from `min` to `max`
+  /// (inclusive), as InsertRays grows it (with a margin). The current count when it already
+  /// covers them.
   std::int64_t CellsToCover(const CellIndex& min, const CellIndex& max) const;
-  /// Cells the dense counters hold now (each sizeof(CellCounts) bytes).
+  /// Cells of the grown bounding box (CellsToCover's measure). Counters are allocated only in
+  /// the tiles of 16 x 16 cells of it that beams have ended in or crossed.
   std::int64_t allocated_cell_count() const {
     return static_cast<std::int64_t>(width_) * static_cast<std::int64_t>(height_);
   }
@@ -129,25 +130,42 @@ class StabilityGrid {
   };
 
   void EnsureCovers(int min_i, int min_j, int max_i, int max_j);
-  bool Allocated(int i, int j) const {
+  // Within the grown bounding box (its counters may not be allocated yet).
+  bool InBox(int i, int j) const {
     return i >= origin_i_ && j >= origin_j_ && i < origin_i_ + width_ && j < origin_j_ + height_;
   }
-  CellCounts& At(int i, int j) {
-    return counts_[static_cast<std::size_t>(j - origin_j_) * static_cast<std::size_t>(width_) +
-                   static_cast<std::size_t>(i - origin_i_)];
-  }
+  // The counters of a cell InBox: nullptr while its tile holds none.
+  const CellCounts* Find(int i, int j) const;
+  // The counters of a cell InBox, its tile allocated when it has none.
+  CellCounts& At(int i, int j);
+  std::size_t TileSlot(int i, int j) const;
+  static std::size_t WithinTile(int i, int j);
+  // Calls visit(i, j, counts) for every cell of an allocated tile, row by row (j, then i).
+  template <typename Visit>
+  void ForEachTiledCell(const Visit& visit) const;
   void AddMiss(int i, int j, int scan_id);
   void AddHit(int i, int j, int scan_id);
   static std::int64_t Key(const CellIndex& cell) { return CellKey(cell.i, cell.j); }
 
   MappingConfig config_;
   double cell_size_m_;
-  // Dense counters over the grown bounding box [origin, origin + size).
+  // The grown bounding box [origin, origin + size) of cells: what max_grid_cells bounds.
   int origin_i_ = 0;
   int origin_j_ = 0;
   int width_ = 0;
   int height_ = 0;
-  std::vector<CellCounts> counts_;
+  // Its counters, in tiles of kTileSide x kTileSide cells (row by row within a tile) allocated
+  // where a beam first ends or passes: in an open hall a few long beams stretch the box to 20-60
+  // times the cells any beam observes (acapulco), and clearing and copying a dense box of them
+  // was 43 % of a relocalization update. Tile (ti, tj) holds cells [ti, ti + 1) * kTileSide
+  // along i and likewise along j; tiles_ spans tiles [tile_origin, tile_origin + tiles) of the box.
+  static constexpr int kTileSide = 16;
+  static constexpr std::size_t kTileCells = std::size_t{kTileSide} * kTileSide;
+  int tile_origin_i_ = 0;
+  int tile_origin_j_ = 0;
+  int tiles_wide_ = 0;
+  int tiles_high_ = 0;
+  std::vector<std::vector<CellCounts>> tiles_;  // empty: no counters yet
   std::int64_t hit_cells_ = 0;
   std::int64_t observed_cells_ = 0;
   std::vector<CellIndex> newly_hit_cells_;
