@@ -292,14 +292,18 @@ TEST(MapSearch, SaysNothingInOneOfTwoIdenticalRooms) {
               Near(result.T_world_robot, in_room_a, 0.3, 3.0));
 }
 
-// The branch and bound finds the pose an exhaustive search over every turn and cell scores best,
-// with beams that fall off the field at every edge for some of them.
-TEST(MapSearch, FindsWhatScoringEveryPoseFinds) {
-  // The field of room A's first places alone: small enough to score every pose.
+// The field of room A's first places alone: small enough to score every pose.
+MapField FirstPlacesField() {
   const std::vector<Place>& places = Recognizer().places();
   std::vector<char> use(places.size(), 0);
   for (std::size_t p = 0; p < std::min<std::size_t>(3, places.size()); ++p) use[p] = 1;
-  const MapField field(places, use);
+  return MapField(places, use);
+}
+
+// The branch and bound finds the pose an exhaustive search over every turn and cell scores best,
+// with beams that fall off the field at every edge for some of them.
+TEST(MapSearch, FindsWhatScoringEveryPoseFinds) {
+  const MapField field = FirstPlacesField();
   ASSERT_FALSE(field.empty());
   const SimulatedDrive drive = Simulate(TwoRooms(), Drive({{-12, -2}, {-8, -2}}), 8);
   const std::vector<Eigen::Vector2d> points = DenseScanPoints(drive.scans[10]).endpoints_m;
@@ -323,10 +327,7 @@ TEST(MapSearch, FindsWhatScoringEveryPoseFinds) {
 // it is their mean; the refined pose scores no less than the search's and stays within its cell
 // and turn step, from any start.
 TEST(MapSearch, RefineInterpolatesBetweenCellsAndStaysWithinOne) {
-  const std::vector<Place>& places = Recognizer().places();
-  std::vector<char> use(places.size(), 0);
-  for (std::size_t p = 0; p < std::min<std::size_t>(3, places.size()); ++p) use[p] = 1;
-  const MapField field(places, use);
+  const MapField field = FirstPlacesField();
   ASSERT_FALSE(field.empty());
   const double cell_m = field.cell_m();
   std::vector<Eigen::Vector2d> on_centres;
