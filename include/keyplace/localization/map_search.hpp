@@ -136,7 +136,8 @@ class MapField {
 /// `every_m` of odometry, the beams of the scans over the last window_m at most (DenseScanPoints)
 /// are searched (MapField::Search); a pose found, refined between the search's cells and turns
 /// (MapField::Refine), becomes an accepted answer. The field is kept between searches for the same
-/// recognizer and the same places allowed; a recognizer changed in place
+/// recognizer and the same places allowed (from a search whose answer was taken, not from one
+/// stopped); a recognizer changed in place
 /// (PlaceRecognizer::AddPlace) needs Reset(true).
 ///
 /// In the background, a search runs on a thread of its own and its answer comes with the first
@@ -174,8 +175,8 @@ class MapSearch {
            running_.search->future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
   }
   /// Searches that ran to their end and were taken, and the time they took (on whichever thread
-  /// ran them, building the field included when the places searched changed); a search stopped
-  /// by Cancel or Reset is not counted.
+  /// ran them, building the field from the places' cells included when the places searched
+  /// changed); a search stopped by Cancel or Reset is not counted, nor is the field it built kept.
   long long searches() const { return searches_; }
   double search_s() const { return search_s_; }
 
@@ -208,7 +209,7 @@ class MapSearch {
   struct Searched {
     MapSearchResult result;
     Pose2 T_world_robot;   // the result's pose refined (MapField::Refine) when found
-    double seconds = 0.0;  // building the field, when it was, included
+    double seconds = 0.0;  // building the field from the cells, when it was, included
     std::shared_ptr<const MapField> field;  // the field searched
   };
   // A search on a thread of its own.

@@ -62,7 +62,8 @@ struct MappingConfig {
   // the box beyond this many cells (a pose jump: an odometry glitch) closes the submap instead:
   // its pose is kept, its beams and keypoints are not inserted, and the submap is flagged
   // `forced`. A single scan that needs more on its own is an error. See docs/MAPPING.md. The
-  // default, 2^24 cells (at most 320 MiB of counters), holds 400 m x 400 m at l_g = 0.1 m.
+  // default, 2^24 cells (about 320 MiB of counters at most: tiles at the box's edges are whole),
+  // holds 400 m x 400 m at l_g = 0.1 m.
   std::int64_t max_grid_cells = std::int64_t{1} << 24;
 };
 

@@ -155,8 +155,8 @@ class StabilityGrid {
   int width_ = 0;
   int height_ = 0;
   // Its counters, in tiles of kTileSide x kTileSide cells (row by row within a tile) allocated
-  // where a beam first ends or passes: in an open hall a few long beams stretch the box to 20-60
-  // times the cells any beam observes (acapulco), and clearing and copying a dense box of them
+  // where a beam first ends or passes: in an open hall a few long beams stretch the box to tens
+  // of times the cells any beam observes (acapulco), and clearing and copying a dense box of them
   // was 43 % of a relocalization update. Tile (ti, tj) holds cells [ti, ti + 1) * kTileSide
   // along i and likewise along j; tiles_ spans tiles [tile_origin, tile_origin + tiles) of the box.
   static constexpr int kTileSide = 16;
