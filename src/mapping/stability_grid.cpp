@@ -78,28 +78,29 @@ CellCounts StabilityGrid::Counts(const CellIndex& cell) const {
   return counts != nullptr ? *counts : CellCounts{};
 }
 
-std::size_t StabilityGrid::TileSlot(int i, int j) const {
-  return static_cast<std::size_t>(TileOf(j, kTileSide) - tile_origin_j_) *
-             static_cast<std::size_t>(tiles_wide_) +
-         static_cast<std::size_t>(TileOf(i, kTileSide) - tile_origin_i_);
-}
-
-std::size_t StabilityGrid::WithinTile(int i, int j) {
-  const int column = i - TileOf(i, kTileSide) * kTileSide;
-  const int row = j - TileOf(j, kTileSide) * kTileSide;
-  return static_cast<std::size_t>(row) * kTileSide + static_cast<std::size_t>(column);
+StabilityGrid::TiledCell StabilityGrid::Locate(int i, int j) const {
+  const int tile_i = TileOf(i, kTileSide);
+  const int tile_j = TileOf(j, kTileSide);
+  const std::size_t slot =
+      static_cast<std::size_t>(tile_j - tile_origin_j_) * static_cast<std::size_t>(tiles_wide_) +
+      static_cast<std::size_t>(tile_i - tile_origin_i_);
+  const std::size_t within = static_cast<std::size_t>(j - tile_j * kTileSide) * kTileSide +
+                             static_cast<std::size_t>(i - tile_i * kTileSide);
+  return {slot, within};
 }
 
 const CellCounts* StabilityGrid::Find(int i, int j) const {
-  const std::vector<CellCounts>& tile = tiles_[TileSlot(i, j)];
+  const TiledCell cell = Locate(i, j);
+  const std::vector<CellCounts>& tile = tiles_[cell.slot];
   if (tile.empty()) return nullptr;
-  return &tile[WithinTile(i, j)];
+  return &tile[cell.within];
 }
 
 CellCounts& StabilityGrid::At(int i, int j) {
-  std::vector<CellCounts>& tile = tiles_[TileSlot(i, j)];
+  const TiledCell cell = Locate(i, j);
+  std::vector<CellCounts>& tile = tiles_[cell.slot];
   if (tile.empty()) tile.resize(kTileCells);
-  return tile[WithinTile(i, j)];
+  return tile[cell.within];
 }
 
 std::int64_t StabilityGrid::CellsToCover(const CellIndex& min, const CellIndex& max) const {

@@ -138,8 +138,12 @@ class StabilityGrid {
   const CellCounts* Find(int i, int j) const;
   // The counters of a cell InBox, its tile allocated when it has none.
   CellCounts& At(int i, int j);
-  std::size_t TileSlot(int i, int j) const;
-  static std::size_t WithinTile(int i, int j);
+  // Where a cell's counters lie: its tile's slot in tiles_, and its place within the tile.
+  struct TiledCell {
+    std::size_t slot = 0;
+    std::size_t within = 0;
+  };
+  TiledCell Locate(int i, int j) const;
   // Calls visit(i, j, counts) for every cell of an allocated tile, row by row (j, then i).
   template <typename Visit>
   void ForEachTiledCell(const Visit& visit) const;
