@@ -64,12 +64,15 @@ std::vector<Eigen::Vector2i> WorldCells(const std::vector<Place>& places,
 }
 
 // The best hits of `scans` (world frame, as the fix put them) over the poses of the search window
-// that keep at least `min_endpoints` of them in the reference's area (turned about the robot's
-// position `robot_m`, then shifted; the fix's own pose is in it), with the correction (world
-// frame) that gives them. No pose keeps enough: hit_fraction 0.
+// that keep at least `min_endpoints` of them in the reference's area and hit with at least
+// `min_hit_fraction` of them (turned about the robot's position `robot_m`, then shifted; the fix's
+// own pose is in it), with the correction (world frame) that gives them; the first of equals.
+// No pose does: hit_fraction 0. A pose is given up once it can no longer beat both the bar and
+// the best so far (DenseReference::HitsReaching), which leaves the best unchanged.
 std::pair<DenseScore, Pose2> BestNearby(const DenseReference& reference,
                                         const std::vector<QueryScanPoints>& scans,
-                                        const Eigen::Vector2d& robot_m, int min_endpoints) {
+                                        const Eigen::Vector2d& robot_m, int min_endpoints,
+                                        double min_hit_fraction) {
   DenseScore best;
   Pose2 best_correction;
   for (int t = -kSearchTurnSteps; t <= kSearchTurnSteps; ++t) {
@@ -79,9 +82,11 @@ std::pair<DenseScore, Pose2> BestNearby(const DenseReference& reference,
       for (int j = -kSearchShiftSteps; j <= kSearchShiftSteps; ++j) {
         const Pose2 correction =
             Pose2(i * kSearchShiftStepM, j * kSearchShiftStepM, 0.0) * turn_about_robot;
-        const DenseScore hits = reference.Hits(correction, scans, kSearchStride);
-        if (hits.endpoints >= min_endpoints && hits.hit_fraction > best.hit_fraction) {
-          best = hits;
+        const std::optional<DenseScore> hits = reference.HitsReaching(
+            correction, scans, kSearchStride, std::max(min_hit_fraction, best.hit_fraction));
+        if (hits && hits->endpoints >= min_endpoints && hits->hit_fraction >= min_hit_fraction &&
+            hits->hit_fraction > best.hit_fraction) {
+          best = *hits;
           best_correction = correction;
         }
       }
@@ -183,7 +188,12 @@ void TrackCheck::Judge(const DenseReference& reference, const std::vector<QueryS
       return;
     }
   }
-  const auto [best, correction] = BestNearby(reference, latest, robot_m, min_endpoints);
+  // Only a pose at least this good can make a suspect (much_better; the tolerance keeps one
+  // that passes it by a rounding error), so no other needs to be scored to the end.
+  const double suspect_bar =
+      std::max(place.dense_sure_hit_fraction, at_fix.hit_fraction + margin) - 1e-9;
+  const auto [best, correction] =
+      BestNearby(reference, latest, robot_m, min_endpoints, suspect_bar);
   if (best.hit_fraction > result.best_hit_fraction) {
     result.best_hit_fraction = best.hit_fraction;
     result.T_world_odom_best = correction * T_world_odom;

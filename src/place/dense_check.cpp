@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace keyplace {
@@ -267,19 +268,38 @@ DenseScore DenseReference::Score(const Pose2& T_ref_query,
 
 DenseScore DenseReference::Hits(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
                                 std::size_t stride) const {
+  // A fraction of at least 0 is always reached.
+  return *HitsReaching(T_ref_query, scans, stride, 0.0);
+}
+
+std::optional<DenseScore> DenseReference::HitsReaching(const Pose2& T_ref_query,
+                                                       const std::vector<QueryScanPoints>& scans,
+                                                       std::size_t stride,
+                                                       double min_hit_fraction) const {
   DenseScore score;
   if (empty()) return score;
   stride = std::max<std::size_t>(stride, 1);
+  std::size_t left = 0;  // endpoints not yet probed
+  for (const QueryScanPoints& scan : scans) left += (scan.endpoints_m.size() + stride - 1) / stride;
   const PointMapper to_ref(T_ref_query);
   int hits = 0;
+  int misses = 0;
   for (const QueryScanPoints& scan : scans) {
     for (std::size_t k = 0; k < scan.endpoints_m.size(); k += stride) {
+      --left;
       const Probe probe = ProbeAt(to_ref(scan.endpoints_m[k]));
       if (!probe.inside) continue;
-      ++score.endpoints;
-      if (probe.flags & kNearOccupied) ++hits;
+      if (probe.flags & kNearOccupied) {
+        ++hits;
+        continue;
+      }
+      ++misses;
+      // The best still possible: every endpoint left inside the area and on a wall.
+      const double most_hits = static_cast<double>(hits) + static_cast<double>(left);
+      if (most_hits < min_hit_fraction * (most_hits + misses)) return std::nullopt;
     }
   }
+  score.endpoints = hits + misses;
   if (score.endpoints > 0) score.hit_fraction = static_cast<double>(hits) / score.endpoints;
   return score;
 }

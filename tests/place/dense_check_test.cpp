@@ -248,6 +248,53 @@ TEST(DenseReference, ShortcutsGiveThePlainWalksScore) {
   EXPECT_GT(through_some_wall, 10);
 }
 
+// A pose HitsReaching gives up on falls short of the bar, one it scores gets Hits' result, and
+// when every endpoint lies in the reference's area (so none can leave the count) it gives up on
+// exactly those below the bar.
+TEST(DenseReference, HitsReachingGivesUpOnlyOnPosesBelowTheBar) {
+  const std::vector<Eigen::Vector2i> cells = OccupiedCells(Room(), kMapPoses);
+  // The same walls with the area grown far beyond the room by two lone cells: no endpoint leaves.
+  std::vector<Eigen::Vector2i> grown = cells;
+  grown.emplace_back(-500, -500);
+  grown.emplace_back(500, 500);
+  const std::vector<QueryScanPoints> scans = QueryScans(Room(), kQueryPoses);
+  const Pose2 T_true = Between(kMapPoses.front(), kQueryPoses.front());
+  std::mt19937 rng(3);
+  std::normal_distribution<double> metres(0.0, 0.15);
+  std::normal_distribution<double> radians(0.0, 0.05);
+  int given_up = 0;
+  int reached = 0;
+  int all_inside = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const DenseReference reference(trial % 3 == 0 ? grown : cells, 0.1);
+    const Pose2 T_ref_query = Pose2(metres(rng), metres(rng), radians(rng)) * T_true;
+    const std::size_t stride = 1 + trial % 2;
+    const double bar = 0.3 + 0.2 * (trial % 4);
+    SCOPED_TRACE(trial);
+    const DenseScore hits = reference.Hits(T_ref_query, scans, stride);
+    const std::optional<DenseScore> reaching =
+        reference.HitsReaching(T_ref_query, scans, stride, bar);
+    if (!reaching) {
+      ++given_up;
+      EXPECT_LT(hits.hit_fraction, bar);
+    } else {
+      EXPECT_EQ(reaching->endpoints, hits.endpoints);
+      EXPECT_EQ(reaching->hit_fraction, hits.hit_fraction);
+      if (hits.hit_fraction >= bar) ++reached;
+    }
+    std::size_t probed = 0;  // every stride-th endpoint of each scan
+    for (const QueryScanPoints& scan : scans)
+      probed += (scan.endpoints_m.size() + stride - 1) / stride;
+    if (static_cast<std::size_t>(hits.endpoints) == probed) {
+      ++all_inside;
+      EXPECT_EQ(reaching.has_value(), hits.hit_fraction >= bar);
+    }
+  }
+  EXPECT_GT(given_up, 20);
+  EXPECT_GT(reached, 20);
+  EXPECT_GT(all_inside, 20);
+}
+
 // Single occupied cells scattered over a hall, many of them just past the border of a skipped
 // block, and beams at every angle: a beam that jumped one sample too far would miss a cell the
 // plain walk enters (and, the cells being alone, sees through).

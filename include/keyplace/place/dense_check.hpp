@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -99,6 +100,14 @@ class DenseReference {
   /// endpoint: cheap enough to compare thousands of poses.
   DenseScore Hits(const Pose2& T_ref_query, const std::vector<QueryScanPoints>& scans,
                   std::size_t stride = 1) const;
+
+  /// Hits, or nothing as soon as the endpoints not yet probed could no longer bring the hit
+  /// fraction to `min_hit_fraction` even if each of them hit: a search over thousands of poses
+  /// wants only those that reach a bar, and most fall short of it within a third of their
+  /// endpoints. A pose that reaches it gets Hits' result exactly.
+  std::optional<DenseScore> HitsReaching(const Pose2& T_ref_query,
+                                         const std::vector<QueryScanPoints>& scans,
+                                         std::size_t stride, double min_hit_fraction) const;
 
   bool empty() const { return flags_.empty(); }
 
