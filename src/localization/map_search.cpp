@@ -374,8 +374,22 @@ void MapSearch::RunningSlot::Stop() {
 
 void MapSearch::Cancel() {
   if (!running_.search) return;
-  searched_at_m_ = running_.search->launched_at_m;
-  running_.Stop();
+  Running stopped = std::move(*running_.search);
+  running_.search.reset();
+  searched_at_m_ = stopped.launched_at_m;
+  stopped.stop->store(true);
+  // The search checks its stop only once its field is built: the wait is for the rest of that
+  // build, and the field then serves the next search of the same places.
+  try {
+    Searched searched = stopped.future.get();
+    if (searched.field) {
+      field_ = std::move(searched.field);
+      field_key_ = std::move(stopped.key);
+    }
+  } catch (const std::exception&) {
+    // A stopped search is dropped unanswered, whatever ended it; a search of the same places
+    // builds the field again and meets the same failure there.
+  }
 }
 
 void MapSearch::AddScan(const LaserScan& scan, const Pose2& T_odom_robot, int scan_id) {
@@ -474,6 +488,7 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
   if (!field) {
     cells = std::make_shared<const MapField::Cells>(
         MapField::OccupiedCells(recognizer.places(), key.use));
+    ++fields_built_;
   }
   const auto search = [field, cells, points = window.points_robot,
                        margin = min_margin_](const std::atomic<bool>* stop) {

@@ -252,6 +252,75 @@ TEST(MapSearch, ResetStopsABackgroundSearchAndACopySearchesAgain) {
   EXPECT_FALSE(search.searching());
 }
 
+// The field of the places searched serves the next search of the same places, and only that:
+// a search of other places (here none) builds theirs, and the first places' field is then built
+// again. Reusing a field for other places would answer from places the exclusion forbids.
+TEST(MapSearch, KeepsTheFieldOnlyForTheSamePlaces) {
+  const PlaceRecognizer recognizer(PlacesFromMap(HallMap()), PlaceRecognitionConfig{});
+  const SimulatedDrive drive = HallQuery();
+  const QueryExclusion everything = [](const Place&, const std::vector<int>&) { return true; };
+  MapSearch search(5.0, 2.0, LocalizerConfig{}.map_search_margin);
+  // Which places each search may use (all, all, none, all) and the fields built after it.
+  const std::vector<std::pair<bool, long long>> steps{{true, 1}, {true, 1}, {false, 2}, {true, 3}};
+  std::size_t step = 0;
+  for (std::size_t i = 0; i < drive.scans.size() && step < steps.size(); ++i) {
+    search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
+    const auto [all_places, built] = steps[step];
+    const long long searches_before = search.searches();
+    const std::optional<LocalizationResult> answer =
+        search.Search(recognizer, all_places ? QueryExclusion{} : everything);
+    if (search.searches() == searches_before) continue;
+    SCOPED_TRACE(::testing::Message() << "search " << step << " at scan " << i);
+    EXPECT_EQ(search.fields_built(), built);
+    EXPECT_EQ(answer.has_value(), all_places);
+    if (answer) {
+      EXPECT_TRUE(Near(answer->T_world_robot, drive.truth[i], 0.3, 3.5));
+    }
+    ++step;
+  }
+  EXPECT_EQ(step, steps.size());
+}
+
+// A background search stopped by Cancel leaves the field it built to the next search of the same
+// recognizer; a search for another recognizer stops the one running and searches its own map:
+// here the hall's places moved 10 m east, where its answer must put the robot.
+TEST(MapSearch, ACancelledSearchLeavesItsFieldAndAnotherMapSearchesItsOwn) {
+  const PlaceRecognizer hall(PlacesFromMap(HallMap()), PlaceRecognitionConfig{});
+  std::vector<Place> moved_places = PlacesFromMap(HallMap());
+  const Pose2 T_moved_world(10.0, 0.0, 0.0);
+  for (Place& place : moved_places) place.T_world_place = T_moved_world * place.T_world_place;
+  const PlaceRecognizer moved(std::move(moved_places), PlaceRecognitionConfig{});
+  const SimulatedDrive drive = HallQuery();
+  MapSearch search(5.0, 2.0, LocalizerConfig{}.map_search_margin, true);
+  std::size_t i = 0;
+  const auto launch = [&](const PlaceRecognizer& recognizer) {
+    for (; i < drive.scans.size() && !search.searching(); ++i) {
+      search.AddScan(drive.scans[i], kTWorldOdom.inverse() * drive.truth[i], static_cast<int>(i));
+      search.Search(recognizer, {});
+    }
+  };
+  launch(hall);
+  ASSERT_TRUE(search.searching());
+  EXPECT_EQ(search.fields_built(), 1);
+  search.Cancel();
+  EXPECT_FALSE(search.searching());
+  EXPECT_EQ(search.searches(), 0);
+  launch(hall);
+  ASSERT_TRUE(search.searching());
+  EXPECT_EQ(search.fields_built(), 1);  // the cancelled search's field
+  // Asked for the moved map, it stops the hall's search, and searches the moved map's field when
+  // the next search is due.
+  EXPECT_FALSE(search.Search(moved, {}).has_value());
+  EXPECT_FALSE(search.searching());
+  launch(moved);
+  ASSERT_TRUE(search.searching());
+  EXPECT_EQ(search.fields_built(), 2);
+  const std::optional<LocalizationResult> answer = AwaitSearch(search, moved);
+  ASSERT_TRUE(answer.has_value());
+  EXPECT_EQ(search.searches(), 1);
+  EXPECT_TRUE(Near(answer->T_world_robot, T_moved_world * drive.truth[i - 1], 0.3, 3.5));
+}
+
 // A search whose stop is raised finds nothing, where the same search unstopped finds the pose.
 TEST(MapSearch, AStoppedSearchFindsNothing) {
   const MapField field(PlacesFromMap(HallMap()));

@@ -136,9 +136,8 @@ class MapField {
 /// `every_m` of odometry, the beams of the scans over the last window_m at most (DenseScanPoints)
 /// are searched (MapField::Search); a pose found, refined between the search's cells and turns
 /// (MapField::Refine), becomes an accepted answer. The field is kept between searches for the same
-/// recognizer and the same places allowed (from a search whose answer was taken, not from one
-/// stopped); a recognizer changed in place
-/// (PlaceRecognizer::AddPlace) needs Reset(true).
+/// recognizer and the same places allowed (from a search taken or stopped by Cancel); a recognizer
+/// changed in place (PlaceRecognizer::AddPlace) needs Reset(true).
 ///
 /// In the background, a search runs on a thread of its own and its answer comes with the first
 /// call to Search after it ends (one search at a time; the answer's T_world_odom holds whenever
@@ -162,7 +161,8 @@ class MapSearch {
   void Reset(bool forget_field = false);
 
   /// Stops a search still running and drops it unanswered (its answer would be stale when it is
-  /// taken: the Relocalizer got a fix meanwhile).
+  /// taken: the Relocalizer got a fix meanwhile). The search stops once its field is built, if it
+  /// builds one, so this may wait for the rest of that build; the field is kept.
   void Cancel();
 
   void set_background(bool background) { background_ = background; }
@@ -176,9 +176,11 @@ class MapSearch {
   }
   /// Searches that ran to their end and were taken, and the time they took (on whichever thread
   /// ran them, building the field from the places' cells included when the places searched
-  /// changed); a search stopped by Cancel or Reset is not counted, nor is the field it built kept.
+  /// changed); a search stopped by Cancel or Reset is not counted.
   long long searches() const { return searches_; }
   double search_s() const { return search_s_; }
+  /// Fields the searches built (one per search whose places differ from the field kept).
+  long long fields_built() const { return fields_built_; }
 
  private:
   struct Recent {
@@ -253,6 +255,7 @@ class MapSearch {
   FieldKey field_key_;
   RunningSlot running_;
   long long searches_ = 0;
+  long long fields_built_ = 0;
   // Numbers the scans kept; not reset, so that answers given before a Reset never seem to share
   // a later window's scans.
   long long scans_kept_ = 0;
