@@ -386,7 +386,7 @@ void MapSearch::Cancel() {
       field_ = std::move(searched.field);
       field_key_ = std::move(stopped.key);
     }
-  } catch (const std::exception&) {
+  } catch (...) {
     // A stopped search is dropped unanswered, whatever ended it; a search of the same places
     // builds the field again and meets the same failure there.
   }
@@ -457,7 +457,12 @@ MapSearch::Window MapSearch::CurrentWindow() const {
 std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recognizer,
                                                     const QueryExclusion& exclusion) {
   // A search begun for another map (or places) than this call's would answer for the wrong one.
-  if (running_.search && &recognizer != running_.search->key.recognizer) Cancel();
+  // Its field is not kept: the map it was built for is the one most likely destroyed next, and
+  // a recognizer made at the same address would take it for its own.
+  if (running_.search && &recognizer != running_.search->key.recognizer) {
+    searched_at_m_ = running_.search->launched_at_m;
+    running_.Stop();
+  }
   if (running_.search) {
     if (!search_ended()) return std::nullopt;
     // Out of the slot before get(), which rethrows what the search threw: no search is left

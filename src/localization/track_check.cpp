@@ -182,9 +182,9 @@ void TrackCheck::Judge(const DenseReference& reference, const std::vector<QueryS
     const DenseScore at_suspect =
         reference.Hits(*suspect * T_world_odom.inverse(), latest, kSearchStride);
     result.best_hit_fraction = at_suspect.hit_fraction;
+    result.T_world_odom_best = *suspect;
     if (much_better(at_suspect)) {
       result.fit = TrackFit::kMisfit;
-      result.T_world_odom_best = *suspect;
       return;
     }
   }

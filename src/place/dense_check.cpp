@@ -294,9 +294,10 @@ std::optional<DenseScore> DenseReference::HitsReaching(const Pose2& T_ref_query,
         continue;
       }
       ++misses;
-      // The best still possible: every endpoint left inside the area and on a wall.
+      // The best still possible: every endpoint left inside the area and on a wall. Divided as the
+      // result is, so that a pose ending exactly at the bar is not given up by a rounding.
       const double most_hits = static_cast<double>(hits) + static_cast<double>(left);
-      if (most_hits < min_hit_fraction * (most_hits + misses)) return std::nullopt;
+      if (most_hits / (most_hits + misses) < min_hit_fraction) return std::nullopt;
     }
   }
   score.endpoints = hits + misses;

@@ -176,7 +176,8 @@ class MapSearch {
   }
   /// Searches that ran to their end and were taken, and the time they took (on whichever thread
   /// ran them, building the field from the places' cells included when the places searched
-  /// changed); a search stopped by Cancel or Reset is not counted.
+  /// changed); a search stopped by Cancel or Reset is not counted, nor is the time it took to
+  /// build the field it leaves to the next.
   long long searches() const { return searches_; }
   double search_s() const { return search_s_; }
   /// Fields the searches built (one per search whose places differ from the field kept).

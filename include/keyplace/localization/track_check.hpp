@@ -36,9 +36,9 @@ struct TrackCheckResult {
   DenseScore score;  // at the fix
   int places = 0;    // map places whose occupancy made the reference
   // The hit fraction of the latest 3 scans at the fix (every 2nd endpoint); when the fix did not
-  // fit beyond doubt, the best over the poses searched around it (the robot turned by up to 45
-  // degrees, shifted by up to 0.8 m) that could make a suspect (0 when none could) and the fix
-  // that gives it.
+  // fit beyond doubt, the best of the last check's suspect, if there was one, and of the poses
+  // searched around the fix (the robot turned by up to 45 degrees, shifted by up to 0.8 m) that
+  // could make a suspect, with the fix that gives it (0 and the fix itself when none could).
   double latest_hit_fraction = 0.0;
   double best_hit_fraction = 0.0;
   Pose2 T_world_odom_best;
