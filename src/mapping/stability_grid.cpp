@@ -25,6 +25,12 @@ bool CellIndexOf(double coordinate_m, double cell_size_m, int& index) {
 // floor(cell / side) for any sign of cell.
 int TileOf(int cell, int side) { return cell >= 0 ? cell / side : -((-cell - 1) / side) - 1; }
 
+// Where tile (ti, tj) of an index `tiles_wide` tiles wide lies in it (relative to its origin).
+std::size_t TileSlot(int ti, int tj, int tiles_wide) {
+  return static_cast<std::size_t>(tj) * static_cast<std::size_t>(tiles_wide) +
+         static_cast<std::size_t>(ti);
+}
+
 std::string PointText(const Eigen::Vector2d& point_m) {
   std::ostringstream text;
   text << "(" << point_m.x() << ", " << point_m.y() << ")";
@@ -81,9 +87,7 @@ CellCounts StabilityGrid::Counts(const CellIndex& cell) const {
 StabilityGrid::TiledCell StabilityGrid::Locate(int i, int j) const {
   const int tile_i = TileOf(i, kTileSide);
   const int tile_j = TileOf(j, kTileSide);
-  const std::size_t slot =
-      static_cast<std::size_t>(tile_j - tile_origin_j_) * static_cast<std::size_t>(tiles_wide_) +
-      static_cast<std::size_t>(tile_i - tile_origin_i_);
+  const std::size_t slot = TileSlot(tile_i - tile_origin_i_, tile_j - tile_origin_j_, tiles_wide_);
   const std::size_t within = static_cast<std::size_t>(j - tile_j * kTileSide) * kTileSide +
                              static_cast<std::size_t>(i - tile_i * kTileSide);
   return {slot, within};
@@ -144,12 +148,8 @@ void StabilityGrid::EnsureCovers(int min_i, int min_j, int max_i, int max_j) {
                                                static_cast<std::size_t>(tiles_high));
     for (int tj = 0; tj < tiles_high_; ++tj) {
       for (int ti = 0; ti < tiles_wide_; ++ti) {
-        const auto target = static_cast<std::size_t>(tj + tile_origin_j_ - tile_min_j) *
-                                static_cast<std::size_t>(tiles_wide) +
-                            static_cast<std::size_t>(ti + tile_origin_i_ - tile_min_i);
-        grown[target] =
-            std::move(tiles_[static_cast<std::size_t>(tj) * static_cast<std::size_t>(tiles_wide_) +
-                             static_cast<std::size_t>(ti)]);
+        grown[TileSlot(ti + tile_origin_i_ - tile_min_i, tj + tile_origin_j_ - tile_min_j,
+                       tiles_wide)] = std::move(tiles_[TileSlot(ti, tj, tiles_wide_)]);
       }
     }
     tiles_ = std::move(grown);
@@ -336,9 +336,7 @@ void StabilityGrid::ForEachTiledCell(const Visit& visit) const {
     for (int row = 0; row < kTileSide; ++row) {
       const int j = (tile_origin_j_ + tj) * kTileSide + row;
       for (int ti = 0; ti < tiles_wide_; ++ti) {
-        const std::vector<CellCounts>& tile =
-            tiles_[static_cast<std::size_t>(tj) * static_cast<std::size_t>(tiles_wide_) +
-                   static_cast<std::size_t>(ti)];
+        const std::vector<CellCounts>& tile = tiles_[TileSlot(ti, tj, tiles_wide_)];
         if (tile.empty()) continue;
         for (int column = 0; column < kTileSide; ++column) {
           visit((tile_origin_i_ + ti) * kTileSide + column, j,
