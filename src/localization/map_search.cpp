@@ -372,12 +372,18 @@ void MapSearch::RunningSlot::Stop() {
   search.reset();
 }
 
-void MapSearch::Cancel() {
+void MapSearch::Cancel() { StopSearch(true); }
+
+void MapSearch::StopSearch(bool keep_field) {
   if (!running_.search) return;
   Running stopped = std::move(*running_.search);
   running_.search.reset();
   searched_at_m_ = stopped.launched_at_m;
   stopped.stop->store(true);
+  if (!keep_field) {
+    stopped.future.wait();
+    return;
+  }
   // The search checks its stop only once its field is built: the wait is for the rest of that
   // build, and the field then serves the next search of the same places.
   try {
@@ -459,10 +465,7 @@ std::optional<LocalizationResult> MapSearch::Search(const PlaceRecognizer& recog
   // A search begun for another map (or places) than this call's would answer for the wrong one.
   // Its field is not kept: the map it was built for is the one most likely destroyed next, and
   // a recognizer made at the same address would take it for its own.
-  if (running_.search && &recognizer != running_.search->key.recognizer) {
-    searched_at_m_ = running_.search->launched_at_m;
-    running_.Stop();
-  }
+  if (running_.search && &recognizer != running_.search->key.recognizer) StopSearch(false);
   if (running_.search) {
     if (!search_ended()) return std::nullopt;
     // Out of the slot before get(), which rethrows what the search threw: no search is left

@@ -239,6 +239,9 @@ class MapSearch {
     std::optional<Running> search;
   };
   Window CurrentWindow() const;
+  // Stops a search still running (uncounted, unanswered) and waits for its thread; keeps the
+  // field it built with keep_field.
+  void StopSearch(bool keep_field);
   // Keeps the searched field for the next search of the same places, counts the search and
   // makes its answer, if it found a pose.
   std::optional<LocalizationResult> TakeAnswer(const Searched& searched, const Window& window,
